@@ -1,0 +1,35 @@
+// Shared helpers for the subcommands: option parsing into the project's types, output files that
+// appear only when complete, and the exit codes every command uses.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+
+#include "models/robot_pose.h"
+
+namespace linetrack::app {
+
+// Exit codes of every command.
+constexpr int kExitOk = 0;
+constexpr int kExitJobFailed = 1;  // the job ran but failed (e.g. no pose found)
+constexpr int kExitBadInput = 2;   // bad usage or bad input (one line on stderr)
+
+// What a chosen subcommand runs after parsing; returns the exit code.
+using CommandAction = std::function<int()>;
+
+// Parses "X,Y,HEADING_DEG" (metres, metres, degrees) into a Pose3Dof with heading in radians.
+// Throws InputError naming `flag` when malformed or not finite.
+Pose3Dof ParsePrior(const std::string& text, const std::string& flag);
+
+// Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
+void CheckRange(double value, double lo, double hi, const std::string& flag);
+
+// Writes `content` to `path` through a temporary file renamed into place, so that a reader never
+// sees a partial file. Throws InputError when the file cannot be written.
+void WriteFileAtomically(const std::string& path, const std::string& content);
+
+// Creates `dir` (and parents) when missing; throws InputError when it cannot.
+void EnsureDirectory(const std::string& dir);
+
+}  // namespace linetrack::app

@@ -1,0 +1,11 @@
+// The subcommands of `linetrack`. Each Add* registers one subcommand on `cli`; when the user
+// picks it, its callback stores the job in *action, which main() runs after parsing.
+#pragma once
+
+#include "app/cli_common.h"
+
+namespace linetrack::app {
+
+void AddModelInfo(CLI::App& cli, CommandAction* action);
+
+}  // namespace linetrack::app

@@ -1,0 +1,68 @@
+// linetrack: localise, track and servo robot cameras against a 3D wireframe model.
+// One binary, one subcommand per job; exit codes in app/cli_common.h.
+#include <arv.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <visp3/core/vpConfig.h>
+#include <visp3/core/vpException.h>
+#include <exception>
+#include <iostream>
+#include <opencv2/core/version.hpp>
+
+#include "app/commands.h"
+#include "models/errors.h"
+
+namespace {
+
+std::string VersionText() {
+  return "linetrack " LINETRACK_VERSION " (ViSP " + std::to_string(VISP_VERSION_MAJOR) + "." +
+         std::to_string(VISP_VERSION_MINOR) + "." + std::to_string(VISP_VERSION_PATCH) +
+         ", OpenCV " CV_VERSION ", Aravis " + std::to_string(arv_get_major_version()) + "." +
+         std::to_string(arv_get_minor_version()) + "." + std::to_string(arv_get_micro_version()) +
+         ")";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace linetrack;
+  auto logger = spdlog::stderr_color_st("linetrack");
+  logger->set_pattern("linetrack: %^%l%$: %v");
+  spdlog::set_default_logger(logger);
+
+  CLI::App cli{
+      "linetrack: localise a robot camera from straight lines against a 3D wireframe model "
+      "(.cao),\ntrack it with ViSP's moving edges, calibrate it, and run it live on a pan-tilt "
+      "head.",
+      "linetrack"};
+  cli.set_version_flag("--version", VersionText(), "Print the version and exit");
+  cli.require_subcommand(1);
+  cli.fallthrough(false);
+  bool quiet = false;
+  cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
+
+  app::CommandAction action;
+  app::AddModelInfo(cli, &action);
+
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return cli.exit(e);
+    std::cerr << "linetrack: " << e.what() << " (see linetrack --help)" << std::endl;
+    return app::kExitBadInput;
+  }
+  if (quiet) spdlog::set_level(spdlog::level::err);
+  try {
+    return action ? action() : app::kExitBadInput;
+  } catch (const InputError& e) {
+    std::cerr << "linetrack: " << e.what() << std::endl;
+    return app::kExitBadInput;
+  } catch (const vpException& e) {
+    std::cerr << "linetrack: ViSP error: " << e.getMessage() << std::endl;
+    return app::kExitJobFailed;
+  } catch (const std::exception& e) {
+    std::cerr << "linetrack: error: " << e.what() << std::endl;
+    return app::kExitJobFailed;
+  }
+}

@@ -1,0 +1,31 @@
+# Helpers shared by every folder: one library per folder, strict warnings on our own code only.
+
+# Warnings for the project's own targets (third-party headers are included as SYSTEM by their
+# imported targets, so -Werror does not trip on them).
+function(linetrack_strict_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
+endfunction()
+
+# linetrack_add_library(NAME linetrack_models SRCS a.cc b.cc PUBLIC_LINK ... PRIVATE_LINK ...)
+function(linetrack_add_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_LINK;PRIVATE_LINK" ${ARGN})
+  add_library(${ARG_NAME} STATIC ${ARG_SRCS})
+  target_include_directories(${ARG_NAME} PUBLIC ${LINETRACK_SOURCE_DIR})
+  target_link_libraries(${ARG_NAME} PUBLIC ${ARG_PUBLIC_LINK} PRIVATE ${ARG_PRIVATE_LINK})
+  set_target_properties(${ARG_NAME} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  linetrack_strict_warnings(${ARG_NAME})
+endfunction()
+
+# linetrack_add_test(NAME models_cao_reader SRCS cao_reader_test.cc LINK linetrack_models)
+# Test names read like `models.CaoReader.Parses...` in ctest.
+function(linetrack_add_test)
+  cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SRCS})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${ARG_NAME} PRIVATE
+    LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
+    LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")
+  linetrack_strict_warnings(${ARG_NAME})
+  gtest_discover_tests(${ARG_NAME} TEST_PREFIX "${ARG_PREFIX}." DISCOVERY_TIMEOUT 60
+    WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+endfunction()
