@@ -98,8 +98,8 @@ class Parser {
     ReadLines(base, num_points);
     ReadFacesFromLines();
     ReadFacesFromPoints(base, num_points);
-    ReadIgnoredSection("cylinders", 3);
-    ReadIgnoredSection("circles", 4);
+    ReadIgnoredSection("cylinders", "cylinder", 3);
+    ReadIgnoredSection("circles", "circle", 4);
     if (next_ < lines_.size()) {
       Fail(lines_[next_].number,
            "unexpected content after the circles section: '" + lines_[next_].tokens.front() + "'");
@@ -327,11 +327,11 @@ class Parser {
   }
 
   // Cylinders (p1 p2 radius) and circles (radius centre p1 p2) are accepted and ignored.
-  void ReadIgnoredSection(const std::string& name, size_t fields) {
+  void ReadIgnoredSection(const std::string& name, const std::string& singular, size_t fields) {
     if (next_ >= lines_.size()) return;  // the trailing sections may be left out
     const long count = ReadCount("number of " + name);
     for (long k = 0; k < count; ++k) {
-      const std::string what = name + " " + std::to_string(k);
+      const std::string what = singular + " " + std::to_string(k);
       const Line& line = Next(what);
       if (line.tokens.size() < fields) {
         Fail(line.number, what + ": needs " + std::to_string(fields) + " values");

@@ -165,19 +165,22 @@ bool NavigableArea::Contains(const Eigen::Vector2d& p) const {
 
 double NavigableArea::Area() const {
   double area = std::abs(outer_.SignedArea());
-  for (const Polygon2& hole : holes_) area -= std::abs(hole.SignedArea());
+  for (const Polygon2& hole : holes_)
+    area -= std::abs(hole.SignedArea());
   return area;
 }
 
 Eigen::Vector2d NavigableArea::BoundsMin() const {
   Eigen::Vector2d lo = outer_.vertices.front();
-  for (const Eigen::Vector2d& v : outer_.vertices) lo = lo.cwiseMin(v);
+  for (const Eigen::Vector2d& v : outer_.vertices)
+    lo = lo.cwiseMin(v);
   return lo;
 }
 
 Eigen::Vector2d NavigableArea::BoundsMax() const {
   Eigen::Vector2d hi = outer_.vertices.front();
-  for (const Eigen::Vector2d& v : outer_.vertices) hi = hi.cwiseMax(v);
+  for (const Eigen::Vector2d& v : outer_.vertices)
+    hi = hi.cwiseMax(v);
   return hi;
 }
 

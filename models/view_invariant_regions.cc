@@ -7,3 +7,11 @@ ViewInvariantRegions ViewInvariantRegions::Build(const WireframeModel&, const Na
   return {};
 }
 }  // namespace linetrack
+namespace linetrack {
+std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery&) const {
+  return {};
+}
+double BearingHalfWidth(const CameraIntrinsics&, double, double) {
+  return kPi;
+}
+}  // namespace linetrack

@@ -1,0 +1,67 @@
+// The set of robot poses consistent with the correspondences assigned so far in the
+// interpretation tree. For a fixed heading every correspondence confines the camera position to
+// a band (non-vertical edge: the position line; vertical edge: the ray from its foot), so the set
+// is kept as heading bins, each with a convex polygon of positions. Each correspondence cuts every
+// bin; a bin whose polygon empties is dropped; no bin left prunes the branch. This keeps the
+// coupling between heading and position that a single heading interval would lose (two vertical
+// correspondences fix the pose up to the inscribed-angle arc: here, a thin polygon per bin).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "matching/constraints.h"
+#include "models/robot_pose.h"
+
+namespace linetrack {
+
+// Convex polygon in the floor plane (counter-clockwise).
+class ConvexPolygon {
+ public:
+  ConvexPolygon() = default;
+  // Regular polygon circumscribing the disk (contains it).
+  static ConvexPolygon AroundDisk(const Eigen::Vector2d& centre, double radius, int sides = 12);
+
+  // Keeps the part where n . p + d >= 0.
+  void ClipHalfPlane(const Eigen::Vector2d& n, double d);
+  bool Empty() const { return vertices_.size() < 3; }
+  Eigen::Vector2d Centroid() const;  // mean of the vertices
+  const std::vector<Eigen::Vector2d>& vertices() const { return vertices_; }
+
+ private:
+  std::vector<Eigen::Vector2d> vertices_;
+};
+
+// Positions possible for headings in [lo, hi]; (cos, sin) of lo, mid and hi cached.
+struct HeadingBin {
+  double lo = 0.0, hi = 0.0;
+  Eigen::Vector2d trig_lo, trig_mid, trig_hi;
+  ConvexPolygon positions;
+};
+
+struct FeasibleRegion {
+  std::vector<HeadingBin> bins;  // ordered by heading, non-empty polygons
+
+  // Bins of at most `bin_width` radians covering `heading`, each with the polygon around the disk.
+  static FeasibleRegion FromPrior(const HeadingInterval& heading, const Eigen::Vector2d& centre,
+                                  double radius, double bin_width);
+
+  bool Empty() const { return bins.empty(); }
+  // Hull of the surviving headings.
+  HeadingInterval Heading() const { return {bins.front().lo, bins.back().hi}; }
+  // A representative pose: the middle surviving bin's heading and polygon centroid.
+  Pose3Dof Representative() const;
+};
+
+// Cuts `region` with a non-vertical correspondence: bins outside the direction intervals are
+// dropped, the others clipped to the position-line band at their mid heading, widened by how far
+// the line moves within the bin. Returns false when nothing is left.
+bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                    FeasibleRegion* region);
+
+// Cuts `region` with a vertical correspondence: each bin's polygon is clipped to the wedge of
+// rays from the foot for the bin's headings (widened by the bearing noise).
+bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                 FeasibleRegion* region);
+
+}  // namespace linetrack

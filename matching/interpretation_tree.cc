@@ -1,0 +1,175 @@
+#include "matching/interpretation_tree.h"
+
+#include <algorithm>
+#include <numeric>
+#include <optional>
+
+namespace linetrack {
+namespace {
+
+// One level of the tree: a model edge and the lines that pass its unary constraint.
+struct Level {
+  int edge = -1;
+  std::vector<int> lines;
+};
+
+class TreeSearch {
+ public:
+  TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
+             const PriorRegion& prior, const InterpretationTreeOptions& options,
+             InterpretationTreeStats* stats)
+      : edges_(edges), lines_(lines), prior_(prior), options_(options), stats_(stats) {
+    gate_.sigmas = options.gate_sigmas;
+    gate_.extent_slack_px = options.extent_slack_px;
+    gate_.focal_px = prior.focal_px;
+  }
+
+  std::vector<Hypothesis> Run() {
+    BuildLevels();
+    const FeasibleRegion root = FeasibleRegion::FromPrior(
+        prior_.heading, prior_.centre, prior_.radius, DegToRad(options_.heading_bin_deg));
+    used_.assign(lines_.size(), false);
+    suffix_.assign(levels_.size() + 1, 0);
+    for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
+      suffix_[i] = suffix_[i + 1] + 1;
+    Search(0, root);
+    return std::move(leaves_);
+  }
+
+ private:
+  // Unary constraints: non-vertical edges against all lines, vertical edges against the lines
+  // that can be images of vertical edges. Non-vertical levels first (they narrow the heading, so
+  // the vertical wedges then cut few bins), each group by candidate count, fewest first.
+  void BuildLevels() {
+    for (size_t e = 0; e < edges_.size(); ++e) {
+      Level level;
+      level.edge = static_cast<int>(e);
+      for (size_t j = 0; j < lines_.size(); ++j) {
+        if (edges_[e].vertical) {
+          if (lines_[j].maybe_vertical &&
+              UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
+                            prior_.radius, gate_)) {
+            level.lines.push_back(static_cast<int>(j));
+          }
+        } else if (!UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
+                                     prior_.centre, prior_.radius, gate_)
+                        .empty()) {
+          level.lines.push_back(static_cast<int>(j));
+        }
+      }
+      stats_->unary_candidates += static_cast<int>(level.lines.size());
+      if (!level.lines.empty()) levels_.push_back(std::move(level));
+    }
+    std::stable_sort(levels_.begin(), levels_.end(), [&](const Level& a, const Level& b) {
+      if (edges_[a.edge].vertical != edges_[b.edge].vertical) return !edges_[a.edge].vertical;
+      return a.lines.size() < b.lines.size();
+    });
+  }
+
+  // Adds (edge, line) to a copy of `region`; false when the pose set becomes empty or a binary
+  // vertical constraint with an assigned vertical correspondence fails.
+  bool Extend(int edge, int line, FeasibleRegion* region) const {
+    const MatchEdge& e = edges_[edge];
+    const ObservedLine& l = lines_[line];
+    if (!e.vertical) return AddNonVertical(l, e, prior_.height, options_.gate_sigmas, region);
+    // The paper's binary constraint (inscribed-angle arc meets the prior disk, left-to-right
+    // order) first: cheap; then the joint cut of the binned region, which subsumes it.
+    for (const auto& [other_edge, other_line] : assigned_) {
+      if (edges_[other_edge].vertical &&
+          !BinaryVertical(lines_[other_line], l, AngleRange(other_edge, edge),
+                          options_.gate_sigmas)) {
+        return false;
+      }
+    }
+    return AddVertical(l, e, options_.gate_sigmas, region);
+  }
+
+  void Search(size_t depth, const FeasibleRegion& region) {
+    if (stats_->nodes >= options_.max_nodes ||
+        static_cast<int>(leaves_.size()) >= options_.max_hypotheses) {
+      stats_->budget_exhausted = true;
+      return;
+    }
+    ++stats_->nodes;
+    if (static_cast<int>(assigned_.size()) + suffix_[depth] < options_.min_matches) return;
+    if (depth == levels_.size()) {
+      if (IsMaximal(region)) leaves_.push_back({assigned_, region});
+      return;
+    }
+    const Level& level = levels_[depth];
+    for (int line : level.lines) {
+      if (used_[line]) continue;
+      FeasibleRegion next = region;
+      if (!Extend(level.edge, line, &next)) continue;
+      used_[line] = true;
+      assigned_.emplace_back(level.edge, line);
+      Search(depth + 1, next);
+      assigned_.pop_back();
+      used_[line] = false;
+    }
+    skipped_.push_back(static_cast<int>(depth));
+    Search(depth + 1, region);
+    skipped_.pop_back();
+  }
+
+  // Inscribed-angle range of two vertical edges over the prior disk, computed once per pair.
+  const HeadingInterval& AngleRange(int edge1, int edge2) const {
+    const size_t key = static_cast<size_t>(edge1) * edges_.size() + edge2;
+    if (angle_ranges_.empty()) angle_ranges_.resize(edges_.size() * edges_.size());
+    if (!angle_ranges_[key]) {
+      angle_ranges_[key] =
+          InscribedAngleRange(edges_[edge1].foot, edges_[edge2].foot, prior_.centre, prior_.radius);
+    }
+    return *angle_ranges_[key];
+  }
+
+  // A leaf is kept only when no skipped edge could have been matched as well: every subset of a
+  // consistent assignment is consistent, and verifying those again would be wasted work.
+  bool IsMaximal(const FeasibleRegion& region) const {
+    for (int depth : skipped_) {
+      const Level& level = levels_[depth];
+      for (int line : level.lines) {
+        if (used_[line]) continue;
+        FeasibleRegion copy = region;
+        if (Extend(level.edge, line, &copy)) return false;
+      }
+    }
+    return true;
+  }
+
+  const std::vector<MatchEdge>& edges_;
+  const std::vector<ObservedLine>& lines_;
+  const PriorRegion& prior_;
+  const InterpretationTreeOptions& options_;
+  InterpretationTreeStats* stats_;
+  Gate gate_;
+  std::vector<Level> levels_;
+  std::vector<int> suffix_;  // levels remaining from each depth
+  std::vector<bool> used_;
+  std::vector<std::pair<int, int>> assigned_;
+  std::vector<int> skipped_;
+  std::vector<Hypothesis> leaves_;
+  mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
+};
+
+}  // namespace
+
+bool InterpretationTreeOptions::Check(std::string* why) const {
+  if (!(gate_sigmas > 0.0) || min_matches < 2 || max_nodes < 1 || max_hypotheses < 1 ||
+      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0)) {
+    *why = "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1";
+    return false;
+  }
+  return true;
+}
+
+std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
+                                           const std::vector<ObservedLine>& lines,
+                                           const PriorRegion& prior,
+                                           const InterpretationTreeOptions& options,
+                                           InterpretationTreeStats* stats) {
+  *stats = InterpretationTreeStats();
+  return TreeSearch(edges, lines, prior, options, stats).Run();
+}
+
+}  // namespace linetrack

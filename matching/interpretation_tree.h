@@ -1,0 +1,56 @@
+// Hypothesis generation by interpretation-tree search (Grimson and Lozano-Perez 1987; Ait Aider
+// et al. 2005, section 3.2). Non-vertical edges are paired with all image lines under the unary
+// constraint, vertical edges with the vertical-candidate lines under the unary wedge and the
+// binary inscribed-angle constraints; along each branch the correspondences must share a common
+// pose (FeasibleRegion). Leaves are maximal consistent assignments of at least k edges.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "matching/feasible_region.h"
+
+namespace linetrack {
+
+struct InterpretationTreeOptions {
+  double gate_sigmas = 3.0;      // noise margins of every constraint, in standard deviations
+  double extent_slack_px = 8.0;  // tolerance of the extent constraints at segment endpoints
+  double heading_bin_deg = 0.5;  // width of the heading bins of the feasible region
+  int min_matches = 4;           // k: leaves with fewer correspondences are discarded
+  int max_nodes = 200000;        // search budget (deterministic)
+  int max_hypotheses = 1000;     // leaves kept at most
+
+  bool Check(std::string* why) const;
+};
+
+// The prior: disk of positions and interval of headings, at known height (metres).
+struct PriorRegion {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius = 0.0;
+  HeadingInterval heading;
+  double height = 0.0;
+  double focal_px = 1000.0;  // mean focal length of the camera (pixels)
+};
+
+// A leaf: (edge index, line index) pairs into the given edge and line lists, and the pose region
+// the correspondences share.
+struct Hypothesis {
+  std::vector<std::pair<int, int>> pairs;
+  FeasibleRegion region;
+};
+
+struct InterpretationTreeStats {
+  int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
+  int nodes = 0;             // tree nodes expanded
+  bool budget_exhausted = false;
+};
+
+// Searches the tree. Deterministic: the same input gives the same leaves in the same order.
+std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
+                                           const std::vector<ObservedLine>& lines,
+                                           const PriorRegion& prior,
+                                           const InterpretationTreeOptions& options,
+                                           InterpretationTreeStats* stats);
+
+}  // namespace linetrack

@@ -1,0 +1,166 @@
+#include "matching/localizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "models/errors.h"
+
+namespace linetrack {
+
+bool LocalizerOptions::Check(std::string* why) const {
+  return noise.Check(why) && tree.Check(why) && verification.Check(why);
+}
+
+void CheckProblem(const LocalizationProblem& p) {
+  auto finite = [](double v, const char* field) {
+    if (!std::isfinite(v)) throw InputError(std::string(field) + ": not a finite number");
+  };
+  finite(p.prior.x, "prior x");
+  finite(p.prior.y, "prior y");
+  finite(p.prior.heading, "prior heading");
+  finite(p.delta_t, "delta_t");
+  finite(p.delta_phi, "delta_phi");
+  finite(p.height, "height");
+  finite(p.tilt, "tilt");
+  if (p.delta_t < 0.0) throw InputError("delta_t: must be >= 0 metres");
+  if (p.delta_phi <= 0.0 || p.delta_phi > kPi)
+    throw InputError("delta_phi: must be in (0, 180] degrees");
+  if (std::abs(p.tilt) >= 0.5 * kPi - 1e-6) throw InputError("tilt: must be in (-90, 90) degrees");
+  if (p.lines.empty()) throw InputError("lines: no line segments");
+  for (size_t i = 0; i < p.lines.size(); ++i) {
+    const Segment2& s = p.lines[i];
+    if (!s.a.allFinite() || !s.b.allFinite()) {
+      throw InputError("lines[" + std::to_string(i) + "]: coordinates are not finite");
+    }
+    if (s.Length() < 1e-6)
+      throw InputError("lines[" + std::to_string(i) + "]: zero-length segment");
+  }
+}
+
+Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* regions,
+                     const CameraIntrinsics& camera, const LocalizerOptions& options)
+    : model_(model),
+      regions_(regions),
+      camera_(camera.Undistorted()),
+      options_(options),
+      occlusion_(model) {
+  std::string why;
+  if (!options_.Check(&why)) throw InputError("localizer options: " + why);
+  if (!camera_.Check(&why)) throw InputError("camera: " + why);
+  if (camera_.width <= 0) throw InputError("camera: the image size is unknown");
+}
+
+std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) const {
+  if (regions_ == nullptr || regions_->size() == 0) {
+    std::vector<int> all(model_.edges().size());
+    std::iota(all.begin(), all.end(), 0);
+    return all;
+  }
+  VisibilityQuery query;
+  query.centre = {problem.prior.x, problem.prior.y};
+  query.radius = problem.delta_t;
+  query.heading = problem.prior.heading;
+  query.heading_margin = problem.delta_phi;
+  query.bearing_half_width = BearingHalfWidth(camera_, problem.tilt, problem.tilt);
+  return regions_->Query(query);
+}
+
+LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
+  CheckProblem(problem);
+  LocalizationResult result;
+  const std::vector<int> ids = CandidateEdges(problem);
+  result.candidate_edges = static_cast<int>(ids.size());
+  const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
+  const std::vector<ObservedLine> lines =
+      PrepareLines(problem.lines, camera_, problem.tilt, options_.noise, options_.tree.gate_sigmas);
+
+  PriorRegion prior;
+  prior.centre = {problem.prior.x, problem.prior.y};
+  prior.radius = problem.delta_t;
+  prior.heading = {problem.prior.heading - problem.delta_phi,
+                   problem.prior.heading + problem.delta_phi};
+  prior.height = problem.height;
+  prior.focal_px = 0.5 * (camera_.px + camera_.py);
+  InterpretationTreeStats stats;
+  const std::vector<Hypothesis> hypotheses =
+      GenerateHypotheses(edges, lines, prior, options_.tree, &stats);
+  result.unary_candidates = stats.unary_candidates;
+  result.tree_nodes = stats.nodes;
+  result.budget_exhausted = stats.budget_exhausted;
+  result.hypotheses = static_cast<int>(hypotheses.size());
+
+  VerificationContext context{&edges, &lines, &camera_, problem.height, problem.tilt};
+  std::vector<VerifiedPose> verified;
+  verified.reserve(hypotheses.size());
+  for (const Hypothesis& h : hypotheses) {
+    verified.push_back(
+        VerifyHypothesis(context, h.pairs, h.region.Representative(), options_.verification));
+  }
+  if (verified.empty()) {
+    result.reason = hypotheses.empty() ? "no consistent hypothesis" : "no hypothesis verified";
+    return result;
+  }
+  // Finalists: the best plausible hypotheses by matched edges, one per distinct pose.
+  std::sort(verified.begin(), verified.end(), BetterThan);
+  const VerificationOptions& vo = options_.verification;
+  auto distinct = [&](const Pose3Dof& a, const Pose3Dof& b) {
+    return std::hypot(a.x - b.x, a.y - b.y) > vo.ambiguity_distance_m ||
+           std::abs(WrapAngle(a.heading - b.heading)) > DegToRad(vo.ambiguity_heading_deg);
+  };
+  std::vector<const VerifiedPose*> finalists;
+  for (const VerifiedPose& v : verified) {
+    if (!v.plausible || static_cast<int>(finalists.size()) >= vo.finalists) break;
+    bool duplicate = false;
+    for (const VerifiedPose* f : finalists)
+      duplicate = duplicate || !distinct(f->pose, v.pose);
+    if (!duplicate) finalists.push_back(&v);
+  }
+  if (finalists.empty()) {
+    const VerifiedPose& best = verified.front();
+    result.reason = "no plausible pose (best: " + std::to_string(best.matched_edges) +
+                    " edges, rms " + std::to_string(best.refinement.rms_px) + " px)";
+    return result;
+  }
+  std::vector<PoseEvidence> evidence;
+  for (const VerifiedPose* f : finalists) {
+    evidence.push_back(Evidence(context, model_, occlusion_, *f, vo));
+  }
+  size_t chosen = 0;
+  for (size_t i = 1; i < finalists.size(); ++i) {
+    if (evidence[i].Score() > evidence[chosen].Score()) chosen = i;
+  }
+  for (size_t i = 0; i < finalists.size(); ++i) {
+    Finalist f{finalists[i]->pose,
+               finalists[i]->matched_edges,
+               finalists[i]->mean_distance_px,
+               evidence[i],
+               {}};
+    for (const auto& [e, l] : finalists[i]->pairs)
+      f.matches.emplace_back(edges[e].edge_id, l);
+    result.finalists.push_back(std::move(f));
+  }
+  std::swap(result.finalists[0], result.finalists[chosen]);
+  const VerifiedPose& best = *finalists[chosen];
+  for (size_t i = 0; i < finalists.size(); ++i) {
+    if (i != chosen && evidence[i].Score() >= vo.ambiguity_ratio * evidence[chosen].Score()) {
+      result.reason = "ambiguous: another pose explains the image almost as well";
+      return result;
+    }
+  }
+  result.support = evidence[chosen].Support();
+  if (result.support < vo.min_support) {
+    result.reason = "low support " + std::to_string(result.support);
+    return result;
+  }
+  result.found = true;
+  result.pose = {best.pose.x, best.pose.y, best.pose.heading, problem.height, problem.tilt};
+  result.cam_from_world = CamFromWorld(result.pose);
+  result.score_px = best.score_px;
+  for (const auto& [e, l] : best.pairs)
+    result.matches.emplace_back(edges[e].edge_id, l);
+  std::sort(result.matches.begin(), result.matches.end());
+  return result;
+}
+
+}  // namespace linetrack

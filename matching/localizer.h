@@ -1,0 +1,93 @@
+// Camera localisation from image lines against a wireframe model, from a rough prior: the
+// three stages of Ait Aider, Hoppenot and Colle (RAS 2005) -- correspondence-space reduction by
+// view-invariant regions, interpretation-tree hypothesis generation, verification.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "matching/interpretation_tree.h"
+#include "matching/observed_line.h"
+#include "matching/verification.h"
+#include "models/camera.h"
+#include "models/occlusion.h"
+#include "models/robot_pose.h"
+#include "models/view_invariant_regions.h"
+#include "models/wireframe.h"
+
+namespace linetrack {
+
+struct LocalizerOptions {
+  LineNoise noise;  // measurement noise the margins come from
+  InterpretationTreeOptions tree;
+  VerificationOptions verification;
+
+  bool Check(std::string* why) const;
+};
+
+// One localisation problem: undistorted image segments (pixels) and the prior.
+struct LocalizationProblem {
+  std::vector<Segment2> lines;
+  Pose3Dof prior;          // x, y (metres), heading (radians)
+  double delta_t = 0.0;    // prior position bound (metres)
+  double delta_phi = 0.0;  // prior heading bound (radians)
+  double height = 0.0;     // camera height (metres)
+  double tilt = 0.0;       // camera tilt (radians, positive down)
+};
+
+// A finalist of the verification, for diagnostics.
+struct Finalist {
+  Pose3Dof pose;
+  int matched_edges = 0;
+  double mean_distance_px = 0.0;
+  PoseEvidence evidence;
+  std::vector<std::pair<int, int>> matches;  // (model edge id, line index)
+};
+
+struct LocalizationResult {
+  bool found = false;
+  RobotPose pose;                                                    // valid when found
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // ViSP's cMo
+  std::vector<std::pair<int, int>> matches;  // (model edge id, line index), sorted
+  double score_px = 0.0;     // eq. 10 partial Hausdorff distance of the accepted pose
+  double support = 0.0;      // share of the predicted visible edge length that is observed
+  int candidate_edges = 0;   // edges kept by the view-invariant regions
+  int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
+  int tree_nodes = 0;
+  int hypotheses = 0;  // hypotheses verified (pose evaluations)
+  bool budget_exhausted = false;
+  std::string reason;               // why no pose was accepted (empty when found)
+  std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first
+};
+
+class Localizer {
+ public:
+  // `regions` may be null: then every model edge is a candidate. The model, regions and camera
+  // must outlive the localizer. Throws InputError when the options or camera are invalid.
+  Localizer(const WireframeModel& model, const ViewInvariantRegions* regions,
+            const CameraIntrinsics& camera, const LocalizerOptions& options = {});
+
+  // Throws InputError when the problem is malformed (NaN, empty or zero-length lines, bounds).
+  LocalizationResult Localize(const LocalizationProblem& problem) const;
+
+  // The model edges possibly visible for the problem's prior (sorted ids).
+  std::vector<int> CandidateEdges(const LocalizationProblem& problem) const;
+
+  const CameraIntrinsics& camera() const { return camera_; }
+  const LocalizerOptions& options() const { return options_; }
+
+ private:
+  const WireframeModel& model_;
+  const ViewInvariantRegions* regions_;
+  CameraIntrinsics camera_;
+  LocalizerOptions options_;
+  OcclusionTester occlusion_;
+};
+
+// Throws InputError naming the field when the problem is malformed.
+void CheckProblem(const LocalizationProblem& problem);
+
+}  // namespace linetrack

@@ -1,0 +1,51 @@
+// Image line segments prepared for matching: interpretation-plane normals in the level frame
+// (tilt undone) and their first-order uncertainty from the measurement noise.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "models/camera.h"
+#include "models/geometry.h"
+
+namespace linetrack {
+
+// Measurement noise of image lines (defaults: the paper's Table 1).
+struct LineNoise {
+  double offset_px = 3.0;        // std of the line's perpendicular offset (pixels)
+  double angle_deg = 1.0;        // std of the line's angle about its midpoint (degrees)
+  double focal_relative = 0.02;  // std of the relative focal-length error (calibration)
+  double tilt_deg = 0.0;         // std of the tilt reading (head encoder)
+
+  bool Check(std::string* why) const;
+};
+
+// One image segment, ready for the constraints. Frames: "level" is the camera frame with the
+// tilt undone (x right, y down = world -z, z level-forward).
+struct ObservedLine {
+  int index = -1;   // position in the input list
+  Segment2 pixels;  // undistorted pixels
+  double length_px = 0.0;
+  Eigen::Vector3d ray_a, ray_b;  // level-frame rays through the endpoints (unit)
+  Eigen::Vector3d normal;        // level-frame unit normal nL of the interpretation plane
+  Eigen::Matrix3d normal_cov;    // covariance of nL (first order)
+  // Vertical-edge candidates: |nL_y| is within the noise (the plane contains the vertical).
+  bool maybe_vertical = false;
+  double bearing = 0.0;        // w: angle of the plane to the right of the optical axis (rad)
+  double bearing_sigma = 0.0;  // std of w (rad)
+};
+
+// Prepares the lines for `camera` (undistorted model) at `tilt` (radians). `gate_sigmas` is the
+// number of standard deviations for the vertical-candidate test. Throws InputError on NaN or
+// zero-length segments (naming the line index).
+std::vector<ObservedLine> PrepareLines(const std::vector<Segment2>& lines,
+                                       const CameraIntrinsics& camera, double tilt,
+                                       const LineNoise& noise, double gate_sigmas);
+
+// Variance of the linear form w . nL for a line (w in level coordinates).
+inline double FormVariance(const ObservedLine& line, const Eigen::Vector3d& w) {
+  return w.dot(line.normal_cov * w);
+}
+
+}  // namespace linetrack

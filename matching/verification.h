@@ -1,0 +1,85 @@
+// Hypothesis verification (paper, section 3.3): pose by Levenberg-Marquardt, model edges
+// projected with it, observed lines matched to them by the segment distance (eq. 9), the
+// correspondence set re-estimated, and the result scored (eq. 10) and judged reliable or not.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "matching/constraints.h"
+#include "matching/pose_refinement.h"
+#include "models/camera.h"
+#include "models/occlusion.h"
+
+namespace linetrack {
+
+struct VerificationOptions {
+  double match_distance_px = 6.0;  // eq. 9 distance below which a line matches an edge
+  double match_angle_deg = 4.0;    // and angle between the line and the projected edge
+  int guided_rounds = 2;           // re-matching + re-estimation rounds
+  double max_rms_px = 4.0;         // endpoint RMS of an acceptable pose
+  int min_matches = 4;             // distinct model edges matched in an accepted pose
+  // Share of the predicted visible model-edge length (edges projecting longer than
+  // support_min_length_px, with occlusion) that observed lines cover.
+  double min_support = 0.5;
+  double support_min_length_px = 40.0;
+  double max_position_sigma_m = 0.15;  // per pixel of noise (pose observability)
+  double max_heading_sigma_deg = 1.5;  // per pixel of noise
+  // A different pose (farther than these) whose evidence score reaches ambiguity_ratio of the
+  // best one's is an ambiguity: no answer. Only the `finalists` best hypotheses (by matched
+  // edges) are scored with occlusion.
+  double ambiguity_distance_m = 0.3;
+  double ambiguity_heading_deg = 5.0;
+  double ambiguity_ratio = 0.8;
+  int finalists = 4;
+  PoseRefinementOptions refinement;
+
+  bool Check(std::string* why) const;
+};
+
+// What a localisation problem looks like to the verifier.
+struct VerificationContext {
+  const std::vector<MatchEdge>* edges = nullptr;  // candidate edges
+  const std::vector<ObservedLine>* lines = nullptr;
+  const CameraIntrinsics* camera = nullptr;  // undistorted model, image size known
+  double height = 0.0;
+  double tilt = 0.0;
+};
+
+// A verified hypothesis.
+struct VerifiedPose {
+  Pose3Dof pose;
+  std::vector<std::pair<int, int>> pairs;  // (edge index, line index), after guided matching
+  int matched_edges = 0;                   // distinct edges in pairs
+  double mean_distance_px = 0.0;           // mean eq. 9 distance over the pairs
+  double score_px = 0.0;                   // eq. 10 partial Hausdorff distance (k = min_matches)
+  PoseRefinementResult refinement;
+  bool plausible = false;  // passed the RMS and observability checks
+};
+
+// Refines the pose of a hypothesis (pairs of edge/line indices) from `start`, then matches all
+// candidate edges to lines at that pose and re-estimates (guided rounds).
+VerifiedPose VerifyHypothesis(const VerificationContext& context,
+                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const VerificationOptions& options);
+
+// Orders verified poses: more matched edges first, then the smaller mean distance.
+bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
+
+// Evidence for a pose beyond its own correspondences: the model edges predicted visible there
+// (with occlusion, all model edges) against the observed lines.
+struct PoseEvidence {
+  double predicted_px = 0.0;  // visible edge length predicted (edges longer than the minimum)
+  double covered_px = 0.0;    // of which covered by the matched observed lines
+  double explained_px = 0.0;  // observed line length matched at this pose
+  double Support() const { return predicted_px > 0.0 ? covered_px / predicted_px : 0.0; }
+  // Observed length explained minus predicted length missing (pixels): the ranking score.
+  double Score() const { return explained_px - (predicted_px - covered_px); }
+};
+
+PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& model,
+                      const OcclusionTester& occlusion, const VerifiedPose& verified,
+                      const VerificationOptions& options);
+
+}  // namespace linetrack
