@@ -17,14 +17,20 @@ class TreeSearch {
  public:
   TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
              const PriorRegion& prior, const InterpretationTreeOptions& options,
-             InterpretationTreeStats* stats)
-      : edges_(edges), lines_(lines), prior_(prior), options_(options), stats_(stats) {
+             const LeafVisitor& visit, InterpretationTreeStats* stats)
+      : edges_(edges),
+        lines_(lines),
+        prior_(prior),
+        options_(options),
+        visit_(visit),
+        stats_(stats),
+        min_matches_(options.min_matches) {
     gate_.sigmas = options.gate_sigmas;
     gate_.extent_slack_px = options.extent_slack_px;
     gate_.focal_px = prior.focal_px;
   }
 
-  std::vector<Hypothesis> Run() {
+  void Run() {
     BuildLevels();
     const FeasibleRegion root = FeasibleRegion::FromPrior(
         prior_.heading, prior_.centre, prior_.radius, DegToRad(options_.heading_bin_deg));
@@ -33,7 +39,6 @@ class TreeSearch {
     for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
       suffix_[i] = suffix_[i + 1] + 1;
     Search(0, root);
-    return std::move(leaves_);
   }
 
  private:
@@ -85,15 +90,17 @@ class TreeSearch {
   }
 
   void Search(size_t depth, const FeasibleRegion& region) {
-    if (stats_->nodes >= options_.max_nodes ||
-        static_cast<int>(leaves_.size()) >= options_.max_hypotheses) {
+    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
       stats_->budget_exhausted = true;
       return;
     }
     ++stats_->nodes;
-    if (static_cast<int>(assigned_.size()) + suffix_[depth] < options_.min_matches) return;
+    if (static_cast<int>(assigned_.size()) + suffix_[depth] < min_matches_) return;
     if (depth == levels_.size()) {
-      if (IsMaximal(region)) leaves_.push_back({assigned_, region});
+      if (IsMaximal(region)) {
+        ++stats_->leaves;
+        min_matches_ = std::max(min_matches_, visit_(Hypothesis{assigned_, region}));
+      }
       return;
     }
     const Level& level = levels_[depth];
@@ -141,14 +148,15 @@ class TreeSearch {
   const std::vector<ObservedLine>& lines_;
   const PriorRegion& prior_;
   const InterpretationTreeOptions& options_;
+  const LeafVisitor& visit_;
   InterpretationTreeStats* stats_;
+  int min_matches_;
   Gate gate_;
   std::vector<Level> levels_;
   std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
   std::vector<std::pair<int, int>> assigned_;
   std::vector<int> skipped_;
-  std::vector<Hypothesis> leaves_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };
 
@@ -163,13 +171,28 @@ bool InterpretationTreeOptions::Check(std::string* why) const {
   return true;
 }
 
+void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const InterpretationTreeOptions& options, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats) {
+  *stats = InterpretationTreeStats();
+  TreeSearch(edges, lines, prior, options, visit, stats).Run();
+}
+
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            const std::vector<ObservedLine>& lines,
                                            const PriorRegion& prior,
                                            const InterpretationTreeOptions& options,
                                            InterpretationTreeStats* stats) {
-  *stats = InterpretationTreeStats();
-  return TreeSearch(edges, lines, prior, options, stats).Run();
+  std::vector<Hypothesis> leaves;
+  SearchInterpretationTree(
+      edges, lines, prior, options,
+      [&](const Hypothesis& h) {
+        leaves.push_back(h);
+        return 0;
+      },
+      stats);
+  return leaves;
 }
 
 }  // namespace linetrack

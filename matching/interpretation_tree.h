@@ -5,6 +5,7 @@
 // pose (FeasibleRegion). Leaves are maximal consistent assignments of at least k edges.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +19,7 @@ struct InterpretationTreeOptions {
   double extent_slack_px = 8.0;  // tolerance of the extent constraints at segment endpoints
   double heading_bin_deg = 0.5;  // width of the heading bins of the feasible region
   int min_matches = 4;           // k: leaves with fewer correspondences are discarded
+  int bound_slack = 2;           // branch and bound: leaves smaller than best - slack are pruned
   int max_nodes = 200000;        // search budget (deterministic)
   int max_hypotheses = 1000;     // leaves kept at most
 
@@ -43,10 +45,23 @@ struct Hypothesis {
 struct InterpretationTreeStats {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int nodes = 0;             // tree nodes expanded
+  int leaves = 0;            // leaves visited
   bool budget_exhausted = false;
 };
 
-// Searches the tree. Deterministic: the same input gives the same leaves in the same order.
+// Called on every leaf in search order. Returns the smallest leaf size still worth exploring
+// (branch and bound: once a hypothesis is verified with m edges, branches that cannot reach about
+// m are pruned); return 0 to keep options.min_matches.
+using LeafVisitor = std::function<int(const Hypothesis&)>;
+
+// Searches the tree depth first, assignments before skips. Deterministic: the same input gives
+// the same leaves in the same order.
+void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const InterpretationTreeOptions& options, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats);
+
+// All leaves (no bound beyond options.min_matches).
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            const std::vector<ObservedLine>& lines,
                                            const PriorRegion& prior,

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <set>
 
 #include "models/errors.h"
 
 namespace linetrack {
 
 bool LocalizerOptions::Check(std::string* why) const {
-  return noise.Check(why) && tree.Check(why) && verification.Check(why);
+  return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
 }
 
 void CheckProblem(const LocalizationProblem& p) {
@@ -39,9 +40,11 @@ void CheckProblem(const LocalizationProblem& p) {
 }
 
 Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* regions,
-                     const CameraIntrinsics& camera, const LocalizerOptions& options)
+                     const NavigableArea* area, const CameraIntrinsics& camera,
+                     const LocalizerOptions& options)
     : model_(model),
       regions_(regions),
+      area_(area),
       camera_(camera.Undistorted()),
       options_(options),
       occlusion_(model) {
@@ -82,45 +85,60 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
                    problem.prior.heading + problem.delta_phi};
   prior.height = problem.height;
   prior.focal_px = 0.5 * (camera_.px + camera_.py);
-  InterpretationTreeStats stats;
-  const std::vector<Hypothesis> hypotheses =
-      GenerateHypotheses(edges, lines, prior, options_.tree, &stats);
-  result.unary_candidates = stats.unary_candidates;
-  result.tree_nodes = stats.nodes;
-  result.budget_exhausted = stats.budget_exhausted;
-  result.hypotheses = static_cast<int>(hypotheses.size());
-
-  VerificationContext context{&edges, &lines, &camera_, problem.height, problem.tilt};
+  VerificationContext context{&edges,       &lines,      &camera_, problem.height,
+                              problem.tilt, &occlusion_, &prior,   area_};
   std::vector<VerifiedPose> verified;
-  verified.reserve(hypotheses.size());
-  for (const Hypothesis& h : hypotheses) {
-    verified.push_back(
-        VerifyHypothesis(context, h.pairs, h.region.Representative(), options_.verification));
+  if (options_.method == MatchMethod::kInterpretationTree) {
+    // Leaves are verified as the search finds them; a plausible pose with m matched edges
+    // raises the bound to m - bound_slack (the truth's leaf holds nearly all its edges).
+    InterpretationTreeStats stats;
+    int best = 0;
+    SearchInterpretationTree(
+        edges, lines, prior, options_.tree,
+        [&](const Hypothesis& h) {
+          verified.push_back(
+              VerifyHypothesis(context, h.pairs, h.region.Representative(), options_.verification));
+          if (verified.back().plausible) best = std::max(best, verified.back().matched_edges);
+          return best - options_.tree.bound_slack;
+        },
+        &stats);
+    result.unary_candidates = stats.unary_candidates;
+    result.tree_nodes = stats.nodes;
+    result.budget_exhausted = stats.budget_exhausted;
+  } else {
+    BaselineStats stats;
+    verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);
+    result.samples = stats.samples;
   }
+  result.hypotheses = static_cast<int>(verified.size());
+  Decide(std::move(verified), context, edges, &result);
+  return result;
+}
+
+void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
+                       const std::vector<MatchEdge>& edges, LocalizationResult* out) const {
+  LocalizationResult& result = *out;
   if (verified.empty()) {
-    result.reason = hypotheses.empty() ? "no consistent hypothesis" : "no hypothesis verified";
-    return result;
+    result.reason = "no consistent hypothesis";
+    return;
   }
-  // Finalists: the best plausible hypotheses by matched edges, one per distinct pose.
+  // Finalists: the plausible hypotheses, best first by matched edges, each distinct set of
+  // correspondences once; all are scored by their evidence (with occlusion).
   std::sort(verified.begin(), verified.end(), BetterThan);
   const VerificationOptions& vo = options_.verification;
-  auto distinct = [&](const Pose3Dof& a, const Pose3Dof& b) {
-    return std::hypot(a.x - b.x, a.y - b.y) > vo.ambiguity_distance_m ||
-           std::abs(WrapAngle(a.heading - b.heading)) > DegToRad(vo.ambiguity_heading_deg);
-  };
   std::vector<const VerifiedPose*> finalists;
+  std::set<std::vector<std::pair<int, int>>> seen;
   for (const VerifiedPose& v : verified) {
     if (!v.plausible || static_cast<int>(finalists.size()) >= vo.finalists) break;
-    bool duplicate = false;
-    for (const VerifiedPose* f : finalists)
-      duplicate = duplicate || !distinct(f->pose, v.pose);
-    if (!duplicate) finalists.push_back(&v);
+    std::vector<std::pair<int, int>> key = v.pairs;
+    std::sort(key.begin(), key.end());
+    if (seen.insert(std::move(key)).second) finalists.push_back(&v);
   }
   if (finalists.empty()) {
     const VerifiedPose& best = verified.front();
     result.reason = "no plausible pose (best: " + std::to_string(best.matched_edges) +
                     " edges, rms " + std::to_string(best.refinement.rms_px) + " px)";
-    return result;
+    return;
   }
   std::vector<PoseEvidence> evidence;
   for (const VerifiedPose* f : finalists) {
@@ -130,7 +148,13 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   for (size_t i = 1; i < finalists.size(); ++i) {
     if (evidence[i].Score() > evidence[chosen].Score()) chosen = i;
   }
+  const VerifiedPose& best = *finalists[chosen];
+  auto distinct = [&](const Pose3Dof& a, const Pose3Dof& b) {
+    return std::hypot(a.x - b.x, a.y - b.y) > vo.ambiguity_distance_m ||
+           std::abs(WrapAngle(a.heading - b.heading)) > DegToRad(vo.ambiguity_heading_deg);
+  };
   for (size_t i = 0; i < finalists.size(); ++i) {
+    if (i == chosen || !distinct(finalists[i]->pose, best.pose)) continue;
     Finalist f{finalists[i]->pose,
                finalists[i]->matched_edges,
                finalists[i]->mean_distance_px,
@@ -140,27 +164,32 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       f.matches.emplace_back(edges[e].edge_id, l);
     result.finalists.push_back(std::move(f));
   }
-  std::swap(result.finalists[0], result.finalists[chosen]);
-  const VerifiedPose& best = *finalists[chosen];
-  for (size_t i = 0; i < finalists.size(); ++i) {
-    if (i != chosen && evidence[i].Score() >= vo.ambiguity_ratio * evidence[chosen].Score()) {
-      result.reason = "ambiguous: another pose explains the image almost as well";
-      return result;
-    }
+  std::sort(
+      result.finalists.begin(), result.finalists.end(),
+      [](const Finalist& a, const Finalist& b) { return a.evidence.Score() > b.evidence.Score(); });
+  {
+    Finalist f{best.pose, best.matched_edges, best.mean_distance_px, evidence[chosen], {}};
+    for (const auto& [e, l] : best.pairs)
+      f.matches.emplace_back(edges[e].edge_id, l);
+    result.finalists.insert(result.finalists.begin(), std::move(f));
+  }
+  if (result.finalists.size() > 1 &&
+      result.finalists[1].evidence.Score() >= vo.ambiguity_ratio * evidence[chosen].Score()) {
+    result.reason = "ambiguous: another pose explains the image almost as well";
+    return;
   }
   result.support = evidence[chosen].Support();
   if (result.support < vo.min_support) {
     result.reason = "low support " + std::to_string(result.support);
-    return result;
+    return;
   }
   result.found = true;
-  result.pose = {best.pose.x, best.pose.y, best.pose.heading, problem.height, problem.tilt};
+  result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
   result.score_px = best.score_px;
   for (const auto& [e, l] : best.pairs)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());
-  return result;
 }
 
 }  // namespace linetrack

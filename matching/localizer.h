@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "matching/baseline_sampler.h"
 #include "matching/interpretation_tree.h"
 #include "matching/observed_line.h"
 #include "matching/verification.h"
@@ -20,9 +21,15 @@
 
 namespace linetrack {
 
+// How hypotheses are generated: the paper's interpretation tree, or the benchmark's baseline
+// (random pairs of correspondences, no tree).
+enum class MatchMethod { kInterpretationTree, kHypothesizeAndTest };
+
 struct LocalizerOptions {
+  MatchMethod method = MatchMethod::kInterpretationTree;
   LineNoise noise;  // measurement noise the margins come from
   InterpretationTreeOptions tree;
+  BaselineOptions baseline;
   VerificationOptions verification;
 
   bool Check(std::string* why) const;
@@ -58,6 +65,7 @@ struct LocalizationResult {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int tree_nodes = 0;
   int hypotheses = 0;  // hypotheses verified (pose evaluations)
+  int samples = 0;     // baseline only: random pairs drawn
   bool budget_exhausted = false;
   std::string reason;               // why no pose was accepted (empty when found)
   std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first
@@ -65,10 +73,12 @@ struct LocalizationResult {
 
 class Localizer {
  public:
-  // `regions` may be null: then every model edge is a candidate. The model, regions and camera
-  // must outlive the localizer. Throws InputError when the options or camera are invalid.
+  // `regions` may be null: then every model edge is a candidate; `area` may be null: then poses
+  // are not checked against the navigable area. The model, regions and area must outlive the
+  // localizer. Throws InputError when the options or camera are invalid.
   Localizer(const WireframeModel& model, const ViewInvariantRegions* regions,
-            const CameraIntrinsics& camera, const LocalizerOptions& options = {});
+            const NavigableArea* area, const CameraIntrinsics& camera,
+            const LocalizerOptions& options = {});
 
   // Throws InputError when the problem is malformed (NaN, empty or zero-length lines, bounds).
   LocalizationResult Localize(const LocalizationProblem& problem) const;
@@ -80,8 +90,14 @@ class Localizer {
   const LocalizerOptions& options() const { return options_; }
 
  private:
+  // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
+  // and support checks) and fills `result`.
+  void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
+              const std::vector<MatchEdge>& edges, LocalizationResult* result) const;
+
   const WireframeModel& model_;
   const ViewInvariantRegions* regions_;
+  const NavigableArea* area_;
   CameraIntrinsics camera_;
   LocalizerOptions options_;
   OcclusionTester occlusion_;

@@ -52,6 +52,66 @@ std::vector<std::optional<Segment2>> ProjectEdges(const VerificationContext& con
   return out;
 }
 
+bool InsidePrior(const VerificationContext& context, const Pose3Dof& pose,
+                 const VerificationOptions& options) {
+  if (context.area != nullptr &&
+      !context.area->InsideWalls({pose.x, pose.y}, options.wall_margin_m)) {
+    return false;
+  }
+  if (context.prior == nullptr) return true;
+  const PriorRegion& prior = *context.prior;
+  const double margin = DegToRad(options.prior_margin_deg);
+  const double offset = std::abs(WrapAngle(pose.heading - prior.heading.Mid()));
+  return std::hypot(pose.x - prior.centre.x(), pose.y - prior.centre.y()) <=
+             prior.radius + options.prior_margin_m &&
+         offset <= 0.5 * prior.heading.Width() + margin;
+}
+
+// The point of `edge` seen at the middle of the observed segment: the closest point of the edge
+// to the viewing ray through that pixel (world coordinates).
+Eigen::Vector3d PointSeenOnEdge(const MatchEdge& edge, const Segment2& observed,
+                                const Eigen::Isometry3d& cam_from_world, const Eigen::Vector3d& eye,
+                                const CameraIntrinsics& camera) {
+  const Eigen::Vector3d ray = cam_from_world.linear().transpose() * camera.Ray(observed.Mid());
+  const Eigen::Vector3d w0 = eye - edge.a;
+  const Eigen::Vector3d d = edge.b - edge.a;
+  const double a = ray.dot(ray), b = ray.dot(d), c = d.dot(d);
+  const double p = ray.dot(w0), q = d.dot(w0);
+  const double denom = a * c - b * b;
+  const double t = denom > 1e-12 ? std::clamp((a * q - b * p) / denom, 0.0, 1.0) : 0.5;
+  return edge.a + t * d;
+}
+
+// Two lines claiming the same edge over the same stretch cannot both be its image (fragments of
+// one edge do not overlap): one of them is clutter and the distance cannot tell which reliably,
+// so both are dropped. A wrong correspondence is worse than a missing one.
+void DropOverlappingClaims(const std::vector<std::optional<Segment2>>& projected,
+                           const std::vector<ObservedLine>& lines, double overlap_px,
+                           std::vector<std::pair<int, int>>* pairs) {
+  std::vector<bool> drop(pairs->size(), false);
+  for (size_t i = 0; i < pairs->size(); ++i) {
+    for (size_t j = i + 1; j < pairs->size(); ++j) {
+      if ((*pairs)[i].first != (*pairs)[j].first) continue;
+      const Segment2& edge = *projected[(*pairs)[i].first];
+      const Eigen::Vector2d axis = (edge.b - edge.a).normalized();
+      auto span = [&](const Segment2& s) {
+        const double t0 = (s.a - edge.a).dot(axis), t1 = (s.b - edge.a).dot(axis);
+        return std::make_pair(std::min(t0, t1), std::max(t0, t1));
+      };
+      const auto a = span(lines[(*pairs)[i].second].pixels);
+      const auto b = span(lines[(*pairs)[j].second].pixels);
+      if (std::min(a.second, b.second) - std::max(a.first, b.first) > overlap_px) {
+        drop[i] = drop[j] = true;
+      }
+    }
+  }
+  size_t kept = 0;
+  for (size_t i = 0; i < pairs->size(); ++i) {
+    if (!drop[i]) (*pairs)[kept++] = (*pairs)[i];
+  }
+  pairs->resize(kept);
+}
+
 }  // namespace
 
 bool VerificationOptions::Check(std::string* why) const {
@@ -76,17 +136,31 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
     if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
     const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result.pose);
     std::vector<std::pair<int, int>> guided;
+    const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(result.pose, context));
+    const Eigen::Vector3d eye(result.pose.x, result.pose.y, context.height);
+    std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
     for (size_t l = 0; l < context.lines->size(); ++l) {
       const Segment2& observed = (*context.lines)[l].pixels;
-      int best = -1;
-      double best_distance = options.match_distance_px;
+      near.clear();
       for (size_t e = 0; e < projected.size(); ++e) {
         if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
         const double d = SegmentDistance(*projected[e], observed);
-        if (d < best_distance) best_distance = d, best = static_cast<int>(e);
+        if (d < options.match_distance_px) near.emplace_back(d, static_cast<int>(e));
       }
-      if (best >= 0) guided.emplace_back(best, static_cast<int>(l));
+      std::sort(near.begin(), near.end());
+      // The nearest edge that is not hidden where the line lies.
+      for (const auto& [d, e] : near) {
+        if (context.occlusion == nullptr ||
+            !context.occlusion->Blocked(
+                eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye,
+                                     *context.camera))) {
+          guided.emplace_back(e, static_cast<int>(l));
+          break;
+        }
+      }
     }
+
+    DropOverlappingClaims(projected, *context.lines, options.overlap_px, &guided);
     if (guided.size() < 2) break;
     const PoseRefinementResult refined =
         RefinePose(ToLineMatches(context, guided), *context.camera, context.height, context.tilt,
@@ -112,7 +186,9 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
                                               : sum / static_cast<double>(distances.size());
   result.score_px =
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
-  result.plausible = result.matched_edges >= options.min_matches &&
+  result.plausible = std::isfinite(result.mean_distance_px) &&
+                     InsidePrior(context, result.pose, options) &&
+                     result.matched_edges >= options.min_matches &&
                      result.refinement.rms_px <= options.max_rms_px &&
                      result.refinement.position_sigma_m <= options.max_position_sigma_m &&
                      result.refinement.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
@@ -134,26 +210,31 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
   const std::vector<ProjectedEdge> pieces = ProjectVisibleEdges(
       model, occlusion, CamFromWorld(Full(verified.pose, context)), *context.camera, projection);
   PoseEvidence evidence;
-  std::map<int, std::vector<const Segment2*>> lines_of_edge;  // model edge id -> observed lines
-  for (const auto& [e, l] : verified.pairs) {
-    const Segment2& line = (*context.lines)[l].pixels;
-    lines_of_edge[(*context.edges)[e].edge_id].push_back(&line);
-    evidence.explained_px += line.Length();
-  }
   std::map<int, double> visible_length;
   for (const ProjectedEdge& p : pieces)
     visible_length[p.edge_id] += p.image.Length();
+  // Lines matched to edges predicted hidden explain nothing.
+  for (const auto& [e, l] : verified.pairs) {
+    if (visible_length.count((*context.edges)[e].edge_id)) {
+      evidence.explained_px += (*context.lines)[l].pixels.Length();
+    }
+  }
+  const double max_angle = DegToRad(options.support_angle_deg);
   for (const ProjectedEdge& p : pieces) {
     if (visible_length[p.edge_id] < options.support_min_length_px) continue;
     const double length = p.image.Length();
     evidence.predicted_px += length;
-    const auto it = lines_of_edge.find(p.edge_id);
-    if (it == lines_of_edge.end()) continue;
-    // Overlap of the observed lines with the piece, measured along the piece.
+    // Overlap, along the piece, of the observed lines lying near it (any line: the prediction
+    // is confirmed whether or not the line is one of the pose's correspondences).
     const Eigen::Vector2d axis = (p.image.b - p.image.a) / length;
     double piece_covered = 0.0;
-    for (const Segment2* s : it->second) {
-      double t0 = (s->a - p.image.a).dot(axis), t1 = (s->b - p.image.a).dot(axis);
+    for (const ObservedLine& line : *context.lines) {
+      const Segment2& s = line.pixels;
+      if (AngleBetween(p.image, s) > max_angle ||
+          SegmentDistance(p.image, s) > options.support_distance_px) {
+        continue;
+      }
+      double t0 = (s.a - p.image.a).dot(axis), t1 = (s.b - p.image.a).dot(axis);
       if (t0 > t1) std::swap(t0, t1);
       piece_covered += std::max(0.0, std::min(t1, length) - std::max(t0, 0.0));
     }

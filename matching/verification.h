@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "matching/constraints.h"
+#include "matching/interpretation_tree.h"
 #include "matching/pose_refinement.h"
 #include "models/camera.h"
+#include "models/navigable_area.h"
 #include "models/occlusion.h"
 
 namespace linetrack {
@@ -18,21 +20,28 @@ struct VerificationOptions {
   double match_distance_px = 6.0;  // eq. 9 distance below which a line matches an edge
   double match_angle_deg = 4.0;    // and angle between the line and the projected edge
   int guided_rounds = 2;           // re-matching + re-estimation rounds
-  double max_rms_px = 4.0;         // endpoint RMS of an acceptable pose
-  int min_matches = 4;             // distinct model edges matched in an accepted pose
+  double overlap_px = 5.0;         // lines of one edge overlapping more than this: all dropped
+
+  double max_rms_px = 4.0;  // endpoint RMS of an acceptable pose
+  int min_matches = 4;      // distinct model edges matched in an accepted pose
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
   double min_support = 0.5;
   double support_min_length_px = 40.0;
+  double support_distance_px = 10.0;  // a line within this (eq. 9) and angle confirms an edge
+  double support_angle_deg = 6.0;
   double max_position_sigma_m = 0.15;  // per pixel of noise (pose observability)
   double max_heading_sigma_deg = 1.5;  // per pixel of noise
+  double prior_margin_m = 0.5;         // a pose may leave the prior disk by this much
+  double prior_margin_deg = 5.0;       // and the heading interval by this much
+  double wall_margin_m = 0.1;          // and must be this far from walls and obstacles
   // A different pose (farther than these) whose evidence score reaches ambiguity_ratio of the
   // best one's is an ambiguity: no answer. Only the `finalists` best hypotheses (by matched
   // edges) are scored with occlusion.
   double ambiguity_distance_m = 0.3;
   double ambiguity_heading_deg = 5.0;
   double ambiguity_ratio = 0.8;
-  int finalists = 4;
+  int finalists = 24;
   PoseRefinementOptions refinement;
 
   bool Check(std::string* why) const;
@@ -45,6 +54,12 @@ struct VerificationContext {
   const CameraIntrinsics* camera = nullptr;  // undistorted model, image size known
   double height = 0.0;
   double tilt = 0.0;
+  // Faces of the model: a line is matched to an edge only where the edge is not hidden.
+  const OcclusionTester* occlusion = nullptr;
+  // A plausible pose lies within the prior (widened by the options' margins) and, when given,
+  // inside the navigable area.
+  const PriorRegion* prior = nullptr;
+  const NavigableArea* area = nullptr;
 };
 
 // A verified hypothesis.

@@ -152,15 +152,19 @@ NavigableArea NavigableArea::FromModel(const WireframeModel& model,
                            "is not implemented yet)"));
 }
 
-bool NavigableArea::Contains(const Eigen::Vector2d& p) const {
+bool NavigableArea::InsideWalls(const Eigen::Vector2d& p, double margin) const {
   if (!outer_.Contains(p)) return false;
   for (const Polygon2& hole : holes_) {
     if (hole.Contains(p)) return false;
   }
   for (const Segment2& wall : walls_) {
-    if (DistanceToSegment(p, wall) < clearance_) return false;
+    if (DistanceToSegment(p, wall) < margin) return false;
   }
   return true;
+}
+
+bool NavigableArea::Contains(const Eigen::Vector2d& p) const {
+  return InsideWalls(p, clearance_);
 }
 
 double NavigableArea::Area() const {

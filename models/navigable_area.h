@@ -47,6 +47,9 @@ class NavigableArea {
   // True when p is inside the outer boundary, outside every hole, and at least `clearance`
   // from every wall segment.
   bool Contains(const Eigen::Vector2d& p) const;
+  // Inside the outer boundary, outside every hole, and at least `margin` metres from every wall
+  // segment (a smaller clearance than Contains uses).
+  bool InsideWalls(const Eigen::Vector2d& p, double margin = 0.0) const;
 
   const Polygon2& outer() const { return outer_; }
   const std::vector<Polygon2>& holes() const { return holes_; }
