@@ -59,8 +59,9 @@ void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
   for (const Eigen::Vector2d& v : vertices_)
     all_inside = all_inside && n.dot(v) + d >= 0.0;
   if (all_inside) return;
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(vertices_.size() + 1);
+  // Built in a reused buffer, swapped in: no allocation once the buffers have grown.
+  thread_local std::vector<Eigen::Vector2d> out;
+  out.clear();
   for (size_t i = 0; i < vertices_.size(); ++i) {
     const Eigen::Vector2d& a = vertices_[i];
     const Eigen::Vector2d& b = vertices_[(i + 1) % vertices_.size()];
@@ -68,7 +69,7 @@ void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
     if (fa >= 0.0) out.push_back(a);
     if ((fa >= 0.0) != (fb >= 0.0)) out.push_back(a + (fa / (fa - fb)) * (b - a));
   }
-  vertices_ = std::move(out);
+  vertices_.swap(out);
 }
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {

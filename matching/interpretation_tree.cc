@@ -7,10 +7,12 @@
 namespace linetrack {
 namespace {
 
-// One level of the tree: a model edge and the lines that pass its unary constraint.
+// One level of the tree: a model edge and the lines that pass its unary constraint, with the
+// heading interval each allows.
 struct Level {
   int edge = -1;
   std::vector<int> lines;
+  std::vector<HeadingInterval> headings;
 };
 
 class TreeSearch {
@@ -36,6 +38,7 @@ class TreeSearch {
         prior_.heading, prior_.centre, prior_.radius, DegToRad(options_.heading_bin_deg));
     used_.assign(lines_.size(), false);
     suffix_.assign(levels_.size() + 1, 0);
+    regions_.resize(levels_.size() + 2);
     for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
       suffix_[i] = suffix_[i + 1] + 1;
     Search(0, root);
@@ -51,15 +54,20 @@ class TreeSearch {
       level.edge = static_cast<int>(e);
       for (size_t j = 0; j < lines_.size(); ++j) {
         if (edges_[e].vertical) {
-          if (lines_[j].maybe_vertical &&
+          if (!lines_[j].maybe_vertical) continue;
+          const std::optional<HeadingInterval> h =
               UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                            prior_.radius, gate_)) {
-            level.lines.push_back(static_cast<int>(j));
-          }
-        } else if (!UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
-                                     prior_.centre, prior_.radius, gate_)
-                        .empty()) {
+                            prior_.radius, gate_);
+          if (!h) continue;
           level.lines.push_back(static_cast<int>(j));
+          level.headings.push_back(*h);
+        } else {
+          const std::vector<HeadingInterval> h =
+              UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
+                               prior_.radius, gate_);
+          if (h.empty()) continue;
+          level.lines.push_back(static_cast<int>(j));
+          level.headings.push_back({h.front().lo, h.back().hi});
         }
       }
       stats_->unary_candidates += static_cast<int>(level.lines.size());
@@ -95,7 +103,10 @@ class TreeSearch {
       return;
     }
     ++stats_->nodes;
-    if (static_cast<int>(assigned_.size()) + suffix_[depth] < min_matches_) return;
+    if (static_cast<int>(assigned_.size()) + suffix_[depth] < min_matches_ ||
+        static_cast<int>(assigned_.size()) + Reachable(depth, region) < min_matches_) {
+      return;
+    }
     if (depth == levels_.size()) {
       if (IsMaximal(region)) {
         ++stats_->leaves;
@@ -106,7 +117,9 @@ class TreeSearch {
     const Level& level = levels_[depth];
     for (int line : level.lines) {
       if (used_[line]) continue;
-      FeasibleRegion next = region;
+      // Regions live in one buffer per depth, reused: copying keeps their capacity.
+      FeasibleRegion& next = regions_[depth + 1];
+      next = region;
       if (!Extend(level.edge, line, &next)) continue;
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
@@ -130,6 +143,25 @@ class TreeSearch {
     return *angle_ranges_[key];
   }
 
+  // Upper bound on the levels from `depth` on that can still be matched: those with an unused
+  // candidate whose unary heading interval meets the region's headings.
+  int Reachable(size_t depth, const FeasibleRegion& region) const {
+    if (region.Empty()) return 0;
+    const HeadingInterval h = region.Heading();
+    int count = 0;
+    for (size_t d = depth; d < levels_.size(); ++d) {
+      const Level& level = levels_[d];
+      for (size_t c = 0; c < level.lines.size(); ++c) {
+        if (!used_[level.lines[c]] && level.headings[c].lo <= h.hi &&
+            level.headings[c].hi >= h.lo) {
+          ++count;
+          break;
+        }
+      }
+    }
+    return count;
+  }
+
   // A leaf is kept only when no skipped edge could have been matched as well: every subset of a
   // consistent assignment is consistent, and verifying those again would be wasted work.
   bool IsMaximal(const FeasibleRegion& region) const {
@@ -137,8 +169,8 @@ class TreeSearch {
       const Level& level = levels_[depth];
       for (int line : level.lines) {
         if (used_[line]) continue;
-        FeasibleRegion copy = region;
-        if (Extend(level.edge, line, &copy)) return false;
+        maximal_scratch_ = region;
+        if (Extend(level.edge, line, &maximal_scratch_)) return false;
       }
     }
     return true;
@@ -155,6 +187,8 @@ class TreeSearch {
   std::vector<Level> levels_;
   std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
+  std::vector<FeasibleRegion> regions_;  // per depth
+  mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
   std::vector<int> skipped_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;

@@ -26,7 +26,7 @@ struct VerificationOptions {
   int min_matches = 4;      // distinct model edges matched in an accepted pose
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
-  double min_support = 0.5;
+  double min_support = 0.7;
   double support_min_length_px = 40.0;
   double support_distance_px = 10.0;  // a line within this (eq. 9) and angle confirms an edge
   double support_angle_deg = 6.0;
