@@ -93,6 +93,20 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
   return region;
 }
 
+void FeasibleRegion::Refine(int max_bins, double min_width) {
+  while (!bins.empty() && 2 * static_cast<int>(bins.size()) <= max_bins &&
+         bins.front().hi - bins.front().lo > 2.0 * min_width) {
+    std::vector<HeadingBin> split;
+    split.reserve(2 * bins.size());
+    for (const HeadingBin& b : bins) {
+      const double mid = 0.5 * (b.lo + b.hi);
+      split.push_back({b.lo, mid, b.trig_lo, Trig(0.5 * (b.lo + mid)), Trig(mid), b.positions});
+      split.push_back({mid, b.hi, Trig(mid), Trig(0.5 * (mid + b.hi)), b.trig_hi, b.positions});
+    }
+    bins.swap(split);
+  }
+}
+
 Pose3Dof FeasibleRegion::Representative() const {
   const HeadingBin& bin = bins[bins.size() / 2];
   const Eigen::Vector2d c = bin.positions.Centroid();

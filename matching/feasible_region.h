@@ -51,6 +51,11 @@ struct FeasibleRegion {
   HeadingInterval Heading() const { return {bins.front().lo, bins.back().hi}; }
   // A representative pose: the middle surviving bin's heading and polygon centroid.
   Pose3Dof Representative() const;
+
+  // Splits bins in halves (each keeps its polygon) while there are at most `max_bins / 2` and
+  // they are wider than `min_width` radians: coarse bins while the heading is wide, fine ones
+  // once the correspondences have narrowed it.
+  void Refine(int max_bins, double min_width);
 };
 
 // Cuts `region` with a non-vertical correspondence: bins outside the direction intervals are

@@ -34,8 +34,10 @@ class TreeSearch {
 
   void Run() {
     BuildLevels();
-    const FeasibleRegion root = FeasibleRegion::FromPrior(
-        prior_.heading, prior_.centre, prior_.radius, DegToRad(options_.heading_bin_deg));
+    const double min_width = DegToRad(options_.heading_bin_deg);
+    const FeasibleRegion root =
+        FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
+                                  std::max(min_width, prior_.heading.Width() / options_.max_bins));
     used_.assign(lines_.size(), false);
     suffix_.assign(levels_.size() + 1, 0);
     regions_.resize(levels_.size() + 2);
@@ -121,6 +123,7 @@ class TreeSearch {
       FeasibleRegion& next = regions_[depth + 1];
       next = region;
       if (!Extend(level.edge, line, &next)) continue;
+      next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
       Search(depth + 1, next);
@@ -198,7 +201,7 @@ class TreeSearch {
 
 bool InterpretationTreeOptions::Check(std::string* why) const {
   if (!(gate_sigmas > 0.0) || min_matches < 2 || max_nodes < 1 || max_hypotheses < 1 ||
-      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0)) {
+      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1) {
     *why = "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1";
     return false;
   }

@@ -55,6 +55,7 @@ Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* re
 }
 
 std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) const {
+  if (problem.candidate_edges) return *problem.candidate_edges;
   if (regions_ == nullptr || regions_->size() == 0) {
     std::vector<int> all(model_.edges().size());
     std::iota(all.begin(), all.end(), 0);
@@ -148,7 +149,11 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   for (size_t i = 1; i < finalists.size(); ++i) {
     if (evidence[i].Score() > evidence[chosen].Score()) chosen = i;
   }
-  const VerifiedPose& best = *finalists[chosen];
+  const VerifiedPose& chosen_pose = *finalists[chosen];
+  // The correspondences reported are matched afresh at the chosen pose, so that hypotheses
+  // converging to the same pose report the same matches.
+  VerifiedPose rematched = Rematch(context, chosen_pose, vo);
+  const VerifiedPose& best = rematched.plausible ? rematched : chosen_pose;
   auto distinct = [&](const Pose3Dof& a, const Pose3Dof& b) {
     return std::hypot(a.x - b.x, a.y - b.y) > vo.ambiguity_distance_m ||
            std::abs(WrapAngle(a.heading - b.heading)) > DegToRad(vo.ambiguity_heading_deg);

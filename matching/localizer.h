@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,9 @@ struct LocalizationProblem {
   double delta_phi = 0.0;  // prior heading bound (radians)
   double height = 0.0;     // camera height (metres)
   double tilt = 0.0;       // camera tilt (radians, positive down)
+  // When set, these model edge ids are the candidates instead of the view-invariant regions'
+  // answer (e.g. a tracker that knows which edges it sees).
+  std::optional<std::vector<int>> candidate_edges;
 };
 
 // A finalist of the verification, for diagnostics.

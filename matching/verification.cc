@@ -82,34 +82,61 @@ Eigen::Vector3d PointSeenOnEdge(const MatchEdge& edge, const Segment2& observed,
   return edge.a + t * d;
 }
 
-// Two lines claiming the same edge over the same stretch cannot both be its image (fragments of
-// one edge do not overlap): one of them is clutter and the distance cannot tell which reliably,
-// so both are dropped. A wrong correspondence is worse than a missing one.
-void DropOverlappingClaims(const std::vector<std::optional<Segment2>>& projected,
-                           const std::vector<ObservedLine>& lines, double overlap_px,
-                           std::vector<std::pair<int, int>>* pairs) {
-  std::vector<bool> drop(pairs->size(), false);
-  for (size_t i = 0; i < pairs->size(); ++i) {
-    for (size_t j = i + 1; j < pairs->size(); ++j) {
-      if ((*pairs)[i].first != (*pairs)[j].first) continue;
-      const Segment2& edge = *projected[(*pairs)[i].first];
-      const Eigen::Vector2d axis = (edge.b - edge.a).normalized();
-      auto span = [&](const Segment2& s) {
-        const double t0 = (s.a - edge.a).dot(axis), t1 = (s.b - edge.a).dot(axis);
-        return std::make_pair(std::min(t0, t1), std::max(t0, t1));
-      };
-      const auto a = span(lines[(*pairs)[i].second].pixels);
-      const auto b = span(lines[(*pairs)[j].second].pixels);
-      if (std::min(a.second, b.second) - std::max(a.first, b.first) > overlap_px) {
-        drop[i] = drop[j] = true;
-      }
-    }
-  }
+// Two lines near the same edge over the same stretch cannot both be its image (fragments of one
+// edge do not overlap): one of them is clutter and the distance cannot tell which reliably, so
+// a claim is dropped when another line within the looser `rivals` window overlaps it along the
+// edge. A wrong correspondence is worse than a missing one. `rivals` are (edge, line) pairs.
+void DropContestedClaims(const std::vector<std::optional<Segment2>>& projected,
+                         const std::vector<ObservedLine>& lines, double overlap_px,
+                         const std::vector<std::pair<int, int>>& rivals,
+                         std::vector<std::pair<int, int>>* pairs) {
+  auto overlap = [&](int edge_index, int line_a, int line_b) {
+    const Segment2& edge = *projected[edge_index];
+    const Eigen::Vector2d axis = (edge.b - edge.a).normalized();
+    auto span = [&](const Segment2& s) {
+      const double t0 = (s.a - edge.a).dot(axis), t1 = (s.b - edge.a).dot(axis);
+      return std::make_pair(std::min(t0, t1), std::max(t0, t1));
+    };
+    const auto a = span(lines[line_a].pixels), b = span(lines[line_b].pixels);
+    return std::min(a.second, b.second) - std::max(a.first, b.first);
+  };
   size_t kept = 0;
-  for (size_t i = 0; i < pairs->size(); ++i) {
-    if (!drop[i]) (*pairs)[kept++] = (*pairs)[i];
+  for (const std::pair<int, int>& claim : *pairs) {
+    bool contested = false;
+    for (const std::pair<int, int>& rival : rivals) {
+      contested = contested || (rival.first == claim.first && rival.second != claim.second &&
+                                overlap(claim.first, claim.second, rival.second) > overlap_px);
+    }
+    if (!contested) (*pairs)[kept++] = claim;
   }
   pairs->resize(kept);
+}
+
+// Matched edges, distances (eq. 9, eq. 10) and plausibility of the pairs at the pose.
+void Score(const VerificationContext& context, const VerificationOptions& options,
+           VerifiedPose* result) {
+  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result->pose);
+  std::vector<double> distances;
+  std::set<int> edges;
+  for (const auto& [e, l] : result->pairs) {
+    edges.insert(e);
+    distances.push_back(projected[e] ? SegmentDistance(*projected[e], (*context.lines)[l].pixels)
+                                     : std::numeric_limits<double>::infinity());
+  }
+  result->matched_edges = static_cast<int>(edges.size());
+  double sum = 0.0;
+  for (double d : distances)
+    sum += d;
+  result->mean_distance_px = distances.empty() ? std::numeric_limits<double>::infinity()
+                                               : sum / static_cast<double>(distances.size());
+  result->score_px =
+      PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
+  const PoseRefinementResult& r = result->refinement;
+  result->plausible =
+      std::isfinite(result->mean_distance_px) && InsidePrior(context, result->pose, options) &&
+      result->matched_edges >= options.min_matches && r.rms_px <= options.max_rms_px &&
+      r.position_sigma_m <= options.max_position_sigma_m &&
+      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 
 }  // namespace
@@ -123,6 +150,56 @@ bool VerificationOptions::Check(std::string* why) const {
   return refinement.Check(why);
 }
 
+std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
+                                               const Pose3Dof& pose,
+                                               const VerificationOptions& options) {
+  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, pose);
+  const double max_angle = DegToRad(options.match_angle_deg);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  const Eigen::Vector3d eye(pose.x, pose.y, context.height);
+  std::vector<std::pair<int, int>> guided, rivals;
+  std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
+  const double rival_distance = options.rival_factor * options.match_distance_px;
+  for (size_t l = 0; l < context.lines->size(); ++l) {
+    const Segment2& observed = (*context.lines)[l].pixels;
+    near.clear();
+    for (size_t e = 0; e < projected.size(); ++e) {
+      if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
+      const double d = SegmentDistance(*projected[e], observed);
+      if (d < rival_distance) rivals.emplace_back(static_cast<int>(e), static_cast<int>(l));
+      if (d < options.match_distance_px) near.emplace_back(d, static_cast<int>(e));
+    }
+    std::sort(near.begin(), near.end());
+    // The nearest edge that is not hidden where the line lies.
+    for (const auto& [d, e] : near) {
+      if (context.occlusion == nullptr ||
+          !context.occlusion->Blocked(eye, PointSeenOnEdge((*context.edges)[e], observed,
+                                                           cam_from_world, eye, *context.camera))) {
+        guided.emplace_back(e, static_cast<int>(l));
+        break;
+      }
+    }
+  }
+  DropContestedClaims(projected, *context.lines, options.overlap_px, rivals, &guided);
+  return guided;
+}
+
+VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
+                     const VerificationOptions& options) {
+  VerifiedPose result = start;
+  for (int round = 0; round < options.guided_rounds; ++round) {
+    if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
+    std::vector<std::pair<int, int>> guided = GuidedMatches(context, result.pose, options);
+    if (guided.size() < 2) break;
+    result.refinement = RefinePose(ToLineMatches(context, guided), *context.camera, context.height,
+                                   context.tilt, result.pose, options.refinement);
+    result.pairs = std::move(guided);
+    result.pose = result.refinement.pose;
+  }
+  Score(context, options, &result);
+  return result;
+}
+
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options) {
@@ -131,68 +208,7 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
   result.refinement = RefinePose(ToLineMatches(context, pairs), *context.camera, context.height,
                                  context.tilt, start, options.refinement);
   result.pose = result.refinement.pose;
-  const double max_angle = DegToRad(options.match_angle_deg);
-  for (int round = 0; round < options.guided_rounds; ++round) {
-    if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
-    const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result.pose);
-    std::vector<std::pair<int, int>> guided;
-    const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(result.pose, context));
-    const Eigen::Vector3d eye(result.pose.x, result.pose.y, context.height);
-    std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
-    for (size_t l = 0; l < context.lines->size(); ++l) {
-      const Segment2& observed = (*context.lines)[l].pixels;
-      near.clear();
-      for (size_t e = 0; e < projected.size(); ++e) {
-        if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
-        const double d = SegmentDistance(*projected[e], observed);
-        if (d < options.match_distance_px) near.emplace_back(d, static_cast<int>(e));
-      }
-      std::sort(near.begin(), near.end());
-      // The nearest edge that is not hidden where the line lies.
-      for (const auto& [d, e] : near) {
-        if (context.occlusion == nullptr ||
-            !context.occlusion->Blocked(
-                eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye,
-                                     *context.camera))) {
-          guided.emplace_back(e, static_cast<int>(l));
-          break;
-        }
-      }
-    }
-
-    DropOverlappingClaims(projected, *context.lines, options.overlap_px, &guided);
-    if (guided.size() < 2) break;
-    const PoseRefinementResult refined =
-        RefinePose(ToLineMatches(context, guided), *context.camera, context.height, context.tilt,
-                   result.pose, options.refinement);
-    result.pairs = std::move(guided);
-    result.refinement = refined;
-    result.pose = refined.pose;
-  }
-  // Score the final pairs at the final pose.
-  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result.pose);
-  std::vector<double> distances;
-  std::set<int> edges;
-  for (const auto& [e, l] : result.pairs) {
-    edges.insert(e);
-    distances.push_back(projected[e] ? SegmentDistance(*projected[e], (*context.lines)[l].pixels)
-                                     : std::numeric_limits<double>::infinity());
-  }
-  result.matched_edges = static_cast<int>(edges.size());
-  double sum = 0.0;
-  for (double d : distances)
-    sum += d;
-  result.mean_distance_px = distances.empty() ? std::numeric_limits<double>::infinity()
-                                              : sum / static_cast<double>(distances.size());
-  result.score_px =
-      PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
-  result.plausible = std::isfinite(result.mean_distance_px) &&
-                     InsidePrior(context, result.pose, options) &&
-                     result.matched_edges >= options.min_matches &&
-                     result.refinement.rms_px <= options.max_rms_px &&
-                     result.refinement.position_sigma_m <= options.max_position_sigma_m &&
-                     result.refinement.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
-  return result;
+  return Rematch(context, result, options);
 }
 
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
@@ -209,36 +225,43 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
   projection.min_length_px = 2.0;
   const std::vector<ProjectedEdge> pieces = ProjectVisibleEdges(
       model, occlusion, CamFromWorld(Full(verified.pose, context)), *context.camera, projection);
-  PoseEvidence evidence;
   std::map<int, double> visible_length;
   for (const ProjectedEdge& p : pieces)
     visible_length[p.edge_id] += p.image.Length();
-  // Lines matched to edges predicted hidden explain nothing.
-  for (const auto& [e, l] : verified.pairs) {
-    if (visible_length.count((*context.edges)[e].edge_id)) {
-      evidence.explained_px += (*context.lines)[l].pixels.Length();
-    }
-  }
+  // A line supports a visible piece when it is one of its edge's correspondences or lies near
+  // it (eq. 9 distance and angle): evidence does not depend on which lines were kept as
+  // correspondences, only on the pose.
   const double max_angle = DegToRad(options.support_angle_deg);
+  const size_t num_lines = context.lines->size();
+  std::vector<bool> explained(num_lines, false);
+  PoseEvidence evidence;
   for (const ProjectedEdge& p : pieces) {
-    if (visible_length[p.edge_id] < options.support_min_length_px) continue;
+    const bool counted = visible_length[p.edge_id] >= options.support_min_length_px;
     const double length = p.image.Length();
-    evidence.predicted_px += length;
-    // Overlap, along the piece, of the observed lines lying near it (any line: the prediction
-    // is confirmed whether or not the line is one of the pose's correspondences).
     const Eigen::Vector2d axis = (p.image.b - p.image.a) / length;
     double piece_covered = 0.0;
-    for (const ObservedLine& line : *context.lines) {
-      const Segment2& s = line.pixels;
-      if (AngleBetween(p.image, s) > max_angle ||
-          SegmentDistance(p.image, s) > options.support_distance_px) {
+    for (size_t l = 0; l < num_lines; ++l) {
+      const Segment2& s = (*context.lines)[l].pixels;
+      const bool matched = std::any_of(verified.pairs.begin(), verified.pairs.end(),
+                                       [&](const std::pair<int, int>& pair) {
+                                         return pair.second == static_cast<int>(l) &&
+                                                (*context.edges)[pair.first].edge_id == p.edge_id;
+                                       });
+      if (!matched && (AngleBetween(p.image, s) > max_angle ||
+                       SegmentDistance(p.image, s) > options.support_distance_px)) {
         continue;
       }
+      explained[l] = true;
       double t0 = (s.a - p.image.a).dot(axis), t1 = (s.b - p.image.a).dot(axis);
       if (t0 > t1) std::swap(t0, t1);
       piece_covered += std::max(0.0, std::min(t1, length) - std::max(t0, 0.0));
     }
+    if (!counted) continue;
+    evidence.predicted_px += length;
     evidence.covered_px += std::min(piece_covered, length);
+  }
+  for (size_t l = 0; l < num_lines; ++l) {
+    if (explained[l]) evidence.explained_px += (*context.lines)[l].pixels.Length();
   }
   return evidence;
 }

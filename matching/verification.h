@@ -21,8 +21,9 @@ struct VerificationOptions {
   double match_angle_deg = 4.0;    // and angle between the line and the projected edge
   int guided_rounds = 2;           // re-matching + re-estimation rounds
   double overlap_px = 5.0;         // lines of one edge overlapping more than this: all dropped
+  double rival_factor = 1.5;       // lines within this x match_distance_px compete for an edge
 
-  double max_rms_px = 4.0;  // endpoint RMS of an acceptable pose
+  double max_rms_px = 6.5;  // endpoint RMS of an acceptable pose
   int min_matches = 4;      // distinct model edges matched in an accepted pose
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
@@ -78,6 +79,17 @@ struct VerifiedPose {
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options);
+
+// Matches every line to the nearest candidate edge projected at `pose` (eq. 9 distance and
+// angle under the options' thresholds), skipping edges hidden where the line lies; lines of one
+// edge that overlap along it are all dropped. Returns (edge index, line index) pairs.
+std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
+                                               const Pose3Dof& pose,
+                                               const VerificationOptions& options);
+
+// Re-matches and re-estimates from `start` (options.guided_rounds rounds), then scores.
+VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
+                     const VerificationOptions& options);
 
 // Orders verified poses: more matched edges first, then the smaller mean distance.
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
