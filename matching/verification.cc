@@ -133,9 +133,9 @@ void Score(const VerificationContext& context, const VerificationOptions& option
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
   result->plausible =
-      std::isfinite(result->mean_distance_px) && InsidePrior(context, result->pose, options) &&
-      result->matched_edges >= options.min_matches && r.rms_px <= options.max_rms_px &&
-      r.position_sigma_m <= options.max_position_sigma_m &&
+      result->mean_distance_px <= options.match_distance_px &&
+      InsidePrior(context, result->pose, options) && result->matched_edges >= options.min_matches &&
+      r.rms_px <= options.max_rms_px && r.position_sigma_m <= options.max_position_sigma_m &&
       r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 
@@ -166,19 +166,22 @@ std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& contex
     for (size_t e = 0; e < projected.size(); ++e) {
       if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
       const double d = SegmentDistance(*projected[e], observed);
-      if (d < rival_distance) rivals.emplace_back(static_cast<int>(e), static_cast<int>(l));
-      if (d < options.match_distance_px) near.emplace_back(d, static_cast<int>(e));
+      if (d < rival_distance) near.emplace_back(d, static_cast<int>(e));
     }
     std::sort(near.begin(), near.end());
-    // The nearest edge that is not hidden where the line lies.
+    // The nearest edge not hidden where the line lies claims it, unless another visible edge
+    // is nearly as near (two edges aligned in the image: the line cannot tell them apart).
+    int claimed = -1, visible = 0;
     for (const auto& [d, e] : near) {
-      if (context.occlusion == nullptr ||
-          !context.occlusion->Blocked(eye, PointSeenOnEdge((*context.edges)[e], observed,
-                                                           cam_from_world, eye, *context.camera))) {
-        guided.emplace_back(e, static_cast<int>(l));
-        break;
+      if (context.occlusion != nullptr &&
+          context.occlusion->Blocked(eye, PointSeenOnEdge((*context.edges)[e], observed,
+                                                          cam_from_world, eye, *context.camera))) {
+        continue;
       }
+      rivals.emplace_back(e, static_cast<int>(l));
+      if (visible++ == 0 && d < options.match_distance_px) claimed = e;
     }
+    if (claimed >= 0 && visible == 1) guided.emplace_back(claimed, static_cast<int>(l));
   }
   DropContestedClaims(projected, *context.lines, options.overlap_px, rivals, &guided);
   return guided;
@@ -228,40 +231,39 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
   std::map<int, double> visible_length;
   for (const ProjectedEdge& p : pieces)
     visible_length[p.edge_id] += p.image.Length();
-  // A line supports a visible piece when it is one of its edge's correspondences or lies near
-  // it (eq. 9 distance and angle): evidence does not depend on which lines were kept as
-  // correspondences, only on the pose.
+  // A line supports a visible piece when it lies near it (eq. 9 distance and angle), weighted by
+  // exp(-d^2 / 2 sigma^2): evidence depends on the pose only, not on which lines were kept as
+  // correspondences, and a close fit counts more than a loose one.
   const double max_angle = DegToRad(options.support_angle_deg);
+  const double sigma2 = options.evidence_sigma_px * options.evidence_sigma_px;
   const size_t num_lines = context.lines->size();
-  std::vector<bool> explained(num_lines, false);
+  std::vector<double> weight_of_line(num_lines, 0.0);
   PoseEvidence evidence;
   for (const ProjectedEdge& p : pieces) {
     const bool counted = visible_length[p.edge_id] >= options.support_min_length_px;
     const double length = p.image.Length();
     const Eigen::Vector2d axis = (p.image.b - p.image.a) / length;
-    double piece_covered = 0.0;
+    double piece_covered = 0.0, piece_weighted = 0.0;
     for (size_t l = 0; l < num_lines; ++l) {
       const Segment2& s = (*context.lines)[l].pixels;
-      const bool matched = std::any_of(verified.pairs.begin(), verified.pairs.end(),
-                                       [&](const std::pair<int, int>& pair) {
-                                         return pair.second == static_cast<int>(l) &&
-                                                (*context.edges)[pair.first].edge_id == p.edge_id;
-                                       });
-      if (!matched && (AngleBetween(p.image, s) > max_angle ||
-                       SegmentDistance(p.image, s) > options.support_distance_px)) {
-        continue;
-      }
-      explained[l] = true;
+      if (AngleBetween(p.image, s) > max_angle) continue;
+      const double d = SegmentDistance(p.image, s);
+      if (d > options.support_distance_px) continue;
+      const double w = std::exp(-0.5 * d * d / sigma2);
+      weight_of_line[l] = std::max(weight_of_line[l], w);
       double t0 = (s.a - p.image.a).dot(axis), t1 = (s.b - p.image.a).dot(axis);
       if (t0 > t1) std::swap(t0, t1);
-      piece_covered += std::max(0.0, std::min(t1, length) - std::max(t0, 0.0));
+      const double overlap = std::max(0.0, std::min(t1, length) - std::max(t0, 0.0));
+      piece_covered += overlap;
+      piece_weighted += w * overlap;
     }
     if (!counted) continue;
     evidence.predicted_px += length;
     evidence.covered_px += std::min(piece_covered, length);
+    evidence.fitted_px += std::min(piece_weighted, length);
   }
   for (size_t l = 0; l < num_lines; ++l) {
-    if (explained[l]) evidence.explained_px += (*context.lines)[l].pixels.Length();
+    evidence.explained_px += weight_of_line[l] * (*context.lines)[l].pixels.Length();
   }
   return evidence;
 }

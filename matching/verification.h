@@ -31,6 +31,7 @@ struct VerificationOptions {
   double support_min_length_px = 40.0;
   double support_distance_px = 10.0;  // a line within this (eq. 9) and angle confirms an edge
   double support_angle_deg = 6.0;
+  double evidence_sigma_px = 3.0;      // a supporting line weighs exp(-d^2 / 2 sigma^2)
   double max_position_sigma_m = 0.15;  // per pixel of noise (pose observability)
   double max_heading_sigma_deg = 1.5;  // per pixel of noise
   double prior_margin_m = 0.5;         // a pose may leave the prior disk by this much
@@ -98,11 +99,12 @@ bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
 // (with occlusion, all model edges) against the observed lines.
 struct PoseEvidence {
   double predicted_px = 0.0;  // visible edge length predicted (edges longer than the minimum)
-  double covered_px = 0.0;    // of which covered by the matched observed lines
-  double explained_px = 0.0;  // observed line length matched at this pose
+  double covered_px = 0.0;    // of which lies along observed lines near it
+  double fitted_px = 0.0;     // the same, each line weighted by how well it fits
+  double explained_px = 0.0;  // observed line length near predicted edges, weighted by the fit
   double Support() const { return predicted_px > 0.0 ? covered_px / predicted_px : 0.0; }
   // Observed length explained minus predicted length missing (pixels): the ranking score.
-  double Score() const { return explained_px - (predicted_px - covered_px); }
+  double Score() const { return explained_px - (predicted_px - fitted_px); }
 };
 
 PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& model,
