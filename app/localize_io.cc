@@ -1,0 +1,195 @@
+#include "app/localize_io.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "models/errors.h"
+
+namespace linetrack::app {
+namespace {
+
+bool ParseNumber(const std::string& text, double* value) {
+  try {
+    size_t used = 0;
+    const std::string trimmed = text.substr(text.find_first_not_of(" \t"));
+    *value = std::stod(trimmed, &used);
+    return trimmed.find_first_not_of(" \t\r", used) == std::string::npos && std::isfinite(*value);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+std::string Resolve(const std::string& path, const std::string& base_dir) {
+  if (path.empty() || path[0] == '/' || base_dir.empty()) return path;
+  return (std::filesystem::path(base_dir) / path).lexically_normal().string();
+}
+
+template <typename T>
+T Required(const nlohmann::json& json, const char* key) {
+  if (!json.contains(key)) throw InputError(std::string("missing key \"") + key + "\"");
+  try {
+    return json.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(std::string("key \"") + key + "\" has the wrong type");
+  }
+}
+
+double FiniteNumber(const nlohmann::json& json, const char* key) {
+  const nlohmann::json& v = json.contains(key) ? json.at(key) : nlohmann::json();
+  if (!v.is_number()) {
+    throw InputError(std::string(json.contains(key) ? "key \"" : "missing key \"") + key +
+                     (json.contains(key) ? "\" is not a number" : "\""));
+  }
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) throw InputError(std::string("key \"") + key + "\" is not finite");
+  return d;
+}
+
+}  // namespace
+
+std::vector<Segment2> ReadLinesCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(Located(path, 0, "cannot read the lines file"));
+  std::vector<Segment2> lines;
+  std::string row;
+  int number = 0;
+  while (std::getline(in, row)) {
+    ++number;
+    if (!row.empty() && row.back() == '\r') row.pop_back();
+    if (row.find_first_not_of(" \t") == std::string::npos || row[0] == '#') continue;
+    std::stringstream fields(row);
+    std::string field;
+    double v[4];
+    int n = 0;
+    bool numeric = true;
+    while (std::getline(fields, field, ',')) {
+      if (n < 4) numeric = numeric && ParseNumber(field, &v[n]);
+      ++n;
+    }
+    if (!numeric && lines.empty() && number == 1) continue;  // header row
+    if (n != 4 || !numeric) {
+      throw InputError(Located(path, number, "expected 4 finite numbers u1,v1,u2,v2"));
+    }
+    lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
+  }
+  if (lines.empty()) throw InputError(Located(path, 0, "no line segments"));
+  return lines;
+}
+
+BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir) {
+  if (!json.is_object()) throw InputError("a case must be a JSON object");
+  BatchCase c;
+  c.id = json.contains("id") && json["id"].is_string() ? json["id"].get<std::string>()
+         : json.contains("id")                         ? json["id"].dump()
+                                                       : "";
+  c.model_path = Resolve(Required<std::string>(json, "model"), base_dir);
+  c.camera_path = Resolve(Required<std::string>(json, "camera"), base_dir);
+  if (json.contains("camera_name")) c.camera_name = Required<std::string>(json, "camera_name");
+  if (!json.contains("lines") || !json["lines"].is_array()) {
+    throw InputError("key \"lines\" must be an array of [u1, v1, u2, v2]");
+  }
+  for (size_t i = 0; i < json["lines"].size(); ++i) {
+    const nlohmann::json& l = json["lines"][i];
+    if (!l.is_array() || l.size() != 4) {
+      throw InputError("lines[" + std::to_string(i) + "] must be [u1, v1, u2, v2]");
+    }
+    double v[4];
+    for (int k = 0; k < 4; ++k) {
+      if (!l[k].is_number()) {
+        throw InputError("lines[" + std::to_string(i) + "] holds a value that is not a number");
+      }
+      v[k] = l[k].get<double>();
+    }
+    c.problem.lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
+  }
+  if (!json.contains("prior") || !json["prior"].is_array() || json["prior"].size() != 3 ||
+      !json["prior"][0].is_number() || !json["prior"][1].is_number() ||
+      !json["prior"][2].is_number()) {
+    throw InputError("key \"prior\" must be [x, y, heading_deg]");
+  }
+  c.problem.prior = {json["prior"][0].get<double>(), json["prior"][1].get<double>(),
+                     DegToRad(json["prior"][2].get<double>())};
+  c.problem.delta_t = FiniteNumber(json, "delta_t");
+  c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
+  c.problem.height = FiniteNumber(json, "height");
+  c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
+  CheckProblem(c.problem);
+  return c;
+}
+
+nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
+                                    double time_ms) {
+  nlohmann::ordered_json out;
+  out["id"] = id;
+  out["found"] = result.found;
+  if (result.found) {
+    out["pose"] = {{"x", result.pose.x},
+                   {"y", result.pose.y},
+                   {"heading_deg", RadToDeg(WrapAngle(result.pose.heading))}};
+    nlohmann::ordered_json cmo = nlohmann::ordered_json::array();
+    const Eigen::Matrix4d m = result.cam_from_world.matrix();
+    for (int r = 0; r < 4; ++r) {
+      cmo.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+    }
+    out["cMo"] = cmo;
+    out["score"] = result.score_px;
+    out["support"] = result.support;
+  } else {
+    out["pose"] = nullptr;
+    out["cMo"] = nullptr;
+    out["score"] = nullptr;
+    out["reason"] = result.reason;
+  }
+  nlohmann::ordered_json matches = nlohmann::ordered_json::array();
+  for (const auto& [edge, line] : result.matches)
+    matches.push_back({edge, line});
+  out["matches"] = matches;
+  out["hypotheses"] = result.hypotheses;
+  out["candidate_edges"] = result.candidate_edges;
+  out["tree_nodes"] = result.tree_nodes;
+  out["time_ms"] = time_ms;
+  return out;
+}
+
+const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
+  auto it = models_.find(model_path);
+  if (it != models_.end()) return it->second;
+  LoadedModel loaded;
+  loaded.model = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  for (const std::string& w : loaded.model->warnings())
+    spdlog::warn("{}", w);
+  try {
+    loaded.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*loaded.model));
+    loaded.regions = std::make_unique<ViewInvariantRegions>(
+        ViewInvariantRegions::Build(*loaded.model, *loaded.area));
+  } catch (const InputError& e) {
+    loaded.area_problem = e.what();
+    spdlog::warn("{}: no navigable area ({}); every edge is a candidate", model_path, e.what());
+  }
+  return models_.emplace(model_path, std::move(loaded)).first->second;
+}
+
+const Localizer& LocalizerCache::Get(const std::string& model_path, const std::string& camera_path,
+                                     const std::string& camera_name) {
+  const std::string key = model_path + "\n" + camera_path + "\n" + camera_name;
+  auto it = localizers_.find(key);
+  if (it != localizers_.end()) return *it->second;
+  const LoadedModel& model = Model(model_path);
+  const std::string camera_key = camera_path + "\n" + camera_name;
+  auto cam = cameras_.find(camera_key);
+  if (cam == cameras_.end()) {
+    cam = cameras_.emplace(camera_key, ReadCameraXml(camera_path, camera_name)).first;
+  }
+  if (cam->second.width <= 0) {
+    throw InputError(Located(camera_path, 0, "the camera file gives no image size"));
+  }
+  auto localizer = std::make_unique<Localizer>(*model.model, model.regions.get(), model.area.get(),
+                                               cam->second, options_);
+  return *localizers_.emplace(key, std::move(localizer)).first->second;
+}
+
+}  // namespace linetrack::app

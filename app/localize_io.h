@@ -1,0 +1,64 @@
+// Files of `linetrack localize`: the line CSV, the batch cases (JSON lines) and the result
+// JSON, plus a cache that loads each model and camera once.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "matching/localizer.h"
+#include "models/navigable_area.h"
+#include "models/view_invariant_regions.h"
+
+namespace linetrack::app {
+
+// Reads `u1,v1,u2,v2` rows (pixels, header row optional). Throws InputError "file:line: what".
+std::vector<Segment2> ReadLinesCsv(const std::string& path);
+
+// One case of a batch file (see docs/matching.md for the format).
+struct BatchCase {
+  std::string id;
+  std::string model_path;  // resolved against the batch file's folder
+  std::string camera_path;
+  std::string camera_name;  // optional "camera_name" key
+  LocalizationProblem problem;
+};
+
+// Parses one JSON line of a batch file; relative paths are resolved against `base_dir`.
+// Throws InputError naming the missing or malformed key.
+BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir);
+
+// The result of one case as a JSON object: id, found, pose, cMo, matches, score, hypotheses,
+// time_ms (and diagnostics: candidate_edges, tree_nodes, reason).
+nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
+                                    double time_ms);
+
+// A model with what localisation needs beside it: navigable area (when derivable) and
+// view-invariant regions.
+struct LoadedModel {
+  std::unique_ptr<WireframeModel> model;
+  std::unique_ptr<NavigableArea> area;            // null when it cannot be derived
+  std::unique_ptr<ViewInvariantRegions> regions;  // null without an area
+  std::string area_problem;                       // why there is no area
+};
+
+// Loads models, cameras and localizers once per distinct path (and camera name).
+class LocalizerCache {
+ public:
+  explicit LocalizerCache(LocalizerOptions options) : options_(std::move(options)) {}
+
+  // Throws InputError when the model or camera cannot be read.
+  const Localizer& Get(const std::string& model_path, const std::string& camera_path,
+                       const std::string& camera_name);
+  const LoadedModel& Model(const std::string& model_path);
+
+ private:
+  LocalizerOptions options_;
+  std::map<std::string, LoadedModel> models_;
+  std::map<std::string, CameraIntrinsics> cameras_;
+  std::map<std::string, std::unique_ptr<Localizer>> localizers_;
+};
+
+}  // namespace linetrack::app
