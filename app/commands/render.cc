@@ -99,9 +99,6 @@ std::vector<SequenceFrame> SequenceFrames(const RenderCommandOptions& opt,
       frames.resize(opt.frames);
     return frames;
   }
-  if (opt.path != "hall-loop") {
-    throw InputError("--path: unknown path '" + opt.path + "' (known: hall-loop)");
-  }
   LoopPathOptions loop_options;
   loop_options.wall_distance = opt.wall_distance;
   DriveOptions drive;
@@ -119,7 +116,52 @@ std::vector<SequenceFrame> SequenceFrames(const RenderCommandOptions& opt,
   return DriveAlongLoop(LoopInsideArea(*area, loop_options), drive);
 }
 
+int WriteOneView(const RenderCommandOptions& opt, const RobotPose& pose, SceneRenderer* renderer) {
+  const auto start = std::chrono::steady_clock::now();
+  const vpImage<unsigned char> image = renderer->Render(CamFromWorld(pose));
+  const double ms = Milliseconds(std::chrono::steady_clock::now() - start);
+  WriteFileAtomically(opt.out, EncodePng(image));
+  std::cout << "wrote " << opt.out << " (" << image.getWidth() << "x" << image.getHeight()
+            << ", rendered in " << ms << " ms)" << std::endl;
+  return kExitOk;
+}
+
+// DIR/frame_%05d.png, groundtruth.txt (TUM), priors.csv and camera.xml; progress on stderr.
+int WriteSequence(const RenderCommandOptions& opt, const std::vector<SequenceFrame>& frames,
+                  SceneRenderer* renderer) {
+  OdometryOptions odometry;
+  odometry.seed = opt.seed;
+  const std::vector<PriorRecord> priors = SimulateOdometryPriors(frames, odometry);
+  EnsureDirectory(opt.out);
+  const std::filesystem::path dir(opt.out);
+  std::vector<double> render_ms, total_ms;
+  const size_t report_every = std::max<size_t>(1, frames.size() / 10);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const auto start = std::chrono::steady_clock::now();
+    const vpImage<unsigned char> image =
+        renderer->Render(frames[f].cam_from_world, static_cast<int>(f));
+    render_ms.push_back(Milliseconds(std::chrono::steady_clock::now() - start));
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05zu.png", f);
+    WriteFileAtomically((dir / name).string(), EncodePng(image));
+    total_ms.push_back(Milliseconds(std::chrono::steady_clock::now() - start));
+    if ((f + 1) % report_every == 0 || f + 1 == frames.size()) {
+      spdlog::info("rendered {}/{} frames", f + 1, frames.size());
+    }
+  }
+  const CameraIntrinsics& camera = renderer->camera();
+  WriteFileAtomically((dir / "groundtruth.txt").string(), FormatTum(GroundTruthPoses(frames)));
+  WriteFileAtomically((dir / "priors.csv").string(), FormatPriors(priors));
+  WriteCameraAtomically((dir / "camera.xml").string(),
+                        opt.undistorted ? camera.Undistorted() : camera);
+  std::cout << "wrote " << frames.size() << " frames (" << camera.width << "x" << camera.height
+            << ") to " << opt.out << ": median " << Median(render_ms) << " ms per frame to render, "
+            << Median(total_ms) << " ms with PNG encoding and writing" << std::endl;
+  return kExitOk;
+}
+
 int RunRender(const RenderCommandOptions& opt) {
+  // Flags first (cheap), then files; nothing is written before everything is known to be valid.
   const int forms = !opt.pose.empty() + !opt.trajectory.empty() + !opt.path.empty();
   if (forms != 1) {
     throw InputError("render: give exactly one of --pose, --trajectory, --path");
@@ -127,8 +169,13 @@ int RunRender(const RenderCommandOptions& opt) {
   const bool single = !opt.pose.empty();
   if (single && !EndsWithPng(opt.out))
     throw InputError("--out: one view is written as a .png file");
+  if (!opt.path.empty() && opt.path != "hall-loop") {
+    throw InputError("--path: unknown path '" + opt.path + "' (known: hall-loop)");
+  }
+  const Pose3Dof planar = single ? ParsePrior(opt.pose, "--pose") : Pose3Dof();
   CheckRange(opt.height, 0.0, 100.0, "--height");
   CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
+  if (opt.frames < 0) throw InputError("--frames: must be >= 0");
   const RenderOptions render_options = ImageOptions(opt);
 
   const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
@@ -153,46 +200,10 @@ int RunRender(const RenderCommandOptions& opt) {
   }
 
   if (single) {
-    const Pose3Dof planar = ParsePrior(opt.pose, "--pose");
     const RobotPose pose{planar.x, planar.y, planar.heading, opt.height, DegToRad(opt.tilt_deg)};
-    const auto start = std::chrono::steady_clock::now();
-    const vpImage<unsigned char> image = renderer.Render(CamFromWorld(pose));
-    const double ms = Milliseconds(std::chrono::steady_clock::now() - start);
-    WriteFileAtomically(opt.out, EncodePng(image));
-    std::cout << "wrote " << opt.out << " (" << camera.width << "x" << camera.height
-              << ", rendered in " << ms << " ms)" << std::endl;
-    return kExitOk;
+    return WriteOneView(opt, pose, &renderer);
   }
-
-  const std::vector<SequenceFrame> frames = SequenceFrames(opt, area);
-  OdometryOptions odometry;
-  odometry.seed = opt.seed;
-  const std::vector<PriorRecord> priors = SimulateOdometryPriors(frames, odometry);
-  EnsureDirectory(opt.out);
-  const std::filesystem::path dir(opt.out);
-  std::vector<double> render_ms, total_ms;
-  const size_t report_every = std::max<size_t>(1, frames.size() / 10);
-  for (size_t f = 0; f < frames.size(); ++f) {
-    const auto start = std::chrono::steady_clock::now();
-    const vpImage<unsigned char> image =
-        renderer.Render(frames[f].cam_from_world, static_cast<int>(f));
-    render_ms.push_back(Milliseconds(std::chrono::steady_clock::now() - start));
-    char name[32];
-    std::snprintf(name, sizeof(name), "frame_%05zu.png", f);
-    WriteFileAtomically((dir / name).string(), EncodePng(image));
-    total_ms.push_back(Milliseconds(std::chrono::steady_clock::now() - start));
-    if ((f + 1) % report_every == 0 || f + 1 == frames.size()) {
-      spdlog::info("rendered {}/{} frames", f + 1, frames.size());
-    }
-  }
-  WriteFileAtomically((dir / "groundtruth.txt").string(), FormatTum(GroundTruthPoses(frames)));
-  WriteFileAtomically((dir / "priors.csv").string(), FormatPriors(priors));
-  WriteCameraAtomically((dir / "camera.xml").string(),
-                        opt.undistorted ? camera.Undistorted() : camera);
-  std::cout << "wrote " << frames.size() << " frames (" << camera.width << "x" << camera.height
-            << ") to " << opt.out << ": median " << Median(render_ms) << " ms per frame to render, "
-            << Median(total_ms) << " ms with PNG encoding and writing" << std::endl;
-  return kExitOk;
+  return WriteSequence(opt, SequenceFrames(opt, area), &renderer);
 }
 
 }  // namespace
