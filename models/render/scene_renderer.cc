@@ -72,6 +72,9 @@ struct SceneRenderer::Impl {
   // Shades canvas pixels [x_begin, x_end) of row y, all showing surface `id` in every sample.
   void ShadeRun(uint16_t id, int y, int x_begin, int x_end, int k, float* out) const;
   void ShadeCanvas(int k);
+  // Sizes the undistorted canvas to hold every output pixel's undistorted position, and
+  // builds the distortion map (CameraIntrinsics::Undistort of each output pixel).
+  void PrepareCanvas();
 };
 
 void SceneRenderer::Impl::Rasterize(const Eigen::Isometry3d& cam_from_world,
@@ -210,6 +213,45 @@ void SceneRenderer::Impl::ShadeCanvas(int k) {
   }
 }
 
+void SceneRenderer::Impl::PrepareCanvas() {
+  distort = options.apply_distortion && camera.has_distortion;
+  double u_lo = -0.5, v_lo = -0.5, u_hi = camera.width - 0.5, v_hi = camera.height - 0.5;
+  if (distort) {
+    // The canvas must hold the undistorted position of every output pixel.
+    auto grow = [&](double u, double v) {
+      const Eigen::Vector2d p = camera.Undistort({u, v});
+      u_lo = std::min(u_lo, p.x());
+      u_hi = std::max(u_hi, p.x());
+      v_lo = std::min(v_lo, p.y());
+      v_hi = std::max(v_hi, p.y());
+    };
+    for (int u = 0; u < camera.width; ++u)
+      grow(u, 0), grow(u, camera.height - 1);
+    for (int v = 0; v < camera.height; ++v)
+      grow(0, v), grow(camera.width - 1, v);
+  }
+  canvas_u = distort ? std::floor(u_lo) - 2.0 : 0.0;
+  canvas_v = distort ? std::floor(v_lo) - 2.0 : 0.0;
+  canvas_width = distort ? static_cast<int>(std::ceil(u_hi) + 3.0 - canvas_u) : camera.width;
+  canvas_height = distort ? static_cast<int>(std::ceil(v_hi) + 3.0 - canvas_v) : camera.height;
+  if (static_cast<double>(canvas_width) * canvas_height >
+      kMaxCanvasGrowth * camera.width * camera.height) {
+    throw InputError("camera: the distortion is too strong to render (kdu = " +
+                     std::to_string(camera.kdu) + ")");
+  }
+  if (distort) {
+    map_x.create(camera.height, camera.width, CV_32F);
+    map_y.create(camera.height, camera.width, CV_32F);
+    for (int v = 0; v < camera.height; ++v) {
+      for (int u = 0; u < camera.width; ++u) {
+        const Eigen::Vector2d p = camera.Undistort({u, v});
+        map_x.at<float>(v, u) = static_cast<float>(p.x() - canvas_u);
+        map_y.at<float>(v, u) = static_cast<float>(p.y() - canvas_v);
+      }
+    }
+  }
+}
+
 bool RenderOptions::Check(std::string* why) const {
   if (!scene.Check(why)) return false;
   if (supersample < 1 || supersample > 4) {
@@ -260,43 +302,7 @@ SceneRenderer::SceneRenderer(const WireframeModel& model, const CameraIntrinsics
     m.shading.push_back(sh);
   }
 
-  m.distort = options.apply_distortion && camera.has_distortion;
-  double u_lo = -0.5, v_lo = -0.5, u_hi = camera.width - 0.5, v_hi = camera.height - 0.5;
-  if (m.distort) {
-    // The canvas must hold the undistorted position of every output pixel.
-    auto grow = [&](double u, double v) {
-      const Eigen::Vector2d p = camera.Undistort({u, v});
-      u_lo = std::min(u_lo, p.x());
-      u_hi = std::max(u_hi, p.x());
-      v_lo = std::min(v_lo, p.y());
-      v_hi = std::max(v_hi, p.y());
-    };
-    for (int u = 0; u < camera.width; ++u)
-      grow(u, 0), grow(u, camera.height - 1);
-    for (int v = 0; v < camera.height; ++v)
-      grow(0, v), grow(camera.width - 1, v);
-  }
-  m.canvas_u = m.distort ? std::floor(u_lo) - 2.0 : 0.0;
-  m.canvas_v = m.distort ? std::floor(v_lo) - 2.0 : 0.0;
-  m.canvas_width = m.distort ? static_cast<int>(std::ceil(u_hi) + 3.0 - m.canvas_u) : camera.width;
-  m.canvas_height =
-      m.distort ? static_cast<int>(std::ceil(v_hi) + 3.0 - m.canvas_v) : camera.height;
-  if (static_cast<double>(m.canvas_width) * m.canvas_height >
-      kMaxCanvasGrowth * camera.width * camera.height) {
-    throw InputError("camera: the distortion is too strong to render (kdu = " +
-                     std::to_string(camera.kdu) + ")");
-  }
-  if (m.distort) {
-    m.map_x.create(camera.height, camera.width, CV_32F);
-    m.map_y.create(camera.height, camera.width, CV_32F);
-    for (int v = 0; v < camera.height; ++v) {
-      for (int u = 0; u < camera.width; ++u) {
-        const Eigen::Vector2d p = camera.Undistort({u, v});
-        m.map_x.at<float>(v, u) = static_cast<float>(p.x() - m.canvas_u);
-        m.map_y.at<float>(v, u) = static_cast<float>(p.y() - m.canvas_v);
-      }
-    }
-  }
+  m.PrepareCanvas();
 }
 
 SceneRenderer::~SceneRenderer() = default;
