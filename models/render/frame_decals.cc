@@ -102,7 +102,8 @@ void PlaneBasis(const Eigen::Vector3d& n, Eigen::Vector3d* e1, Eigen::Vector3d* 
 bool InsidePlanarPolygon(const std::vector<Eigen::Vector3d>& polygon, const Eigen::Vector3d& p,
                          const Eigen::Vector3d& e1, const Eigen::Vector3d& e2) {
   Polygon2 flat;
-  for (const Eigen::Vector3d& c : polygon) flat.vertices.emplace_back(e1.dot(c), e2.dot(c));
+  for (const Eigen::Vector3d& c : polygon)
+    flat.vertices.emplace_back(e1.dot(c), e2.dot(c));
   return flat.Contains({e1.dot(p), e2.dot(p)});
 }
 
