@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   app::CommandAction action;
   app::AddModelInfo(cli, &action);
   app::AddLocalize(cli, &action);
+  app::AddRender(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -1,0 +1,142 @@
+// `linetrack render` end to end: one view equals the library's image, a sequence writes frames,
+// ground truth, priors and camera, and bad input exits 2 with one line and writes nothing.
+#include <gtest/gtest.h>
+
+#include <visp3/io/vpImageIo.h>
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "models/render/scene_renderer.h"
+#include "models/trajectory_io.h"
+
+namespace linetrack {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kModel = kSource + "/models/hall.cao";
+const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
+const std::string kNav = kSource + "/tests/data/hall.nav.json";
+
+struct CommandRun {
+  int code = -1;
+  std::string err;
+};
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class RenderCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+
+  CommandRun Linetrack(const std::string& args) {
+    const std::string err = (dir_ / "stderr.txt").string();
+    const std::string cmd = std::string(LINETRACK_EXE) + " render --model " + kModel +
+                            " --camera " + kCamera + " " + args + " > /dev/null 2> " + err;
+    const int status = std::system(cmd.c_str());
+    CommandRun run;
+    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    run.err = ReadAll(err);
+    fs::remove(err);
+    return run;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(RenderCli, OneViewIsTheLibrarysImage) {
+  const std::string out = (dir_ / "view.png").string();
+  ASSERT_EQ(Linetrack("--pose 2,2,30 --height 1.3 --tilt 5 --seed 4 --out " + out).code, 0);
+  vpImage<unsigned char> written;
+  vpImageIo::read(written, out);
+  RenderOptions options;
+  options.scene.seed = 4;
+  SceneRenderer renderer(WireframeModel::Load(kModel), ReadCameraXml(kCamera), options);
+  const vpImage<unsigned char> expected =
+      renderer.Render(CamFromWorld({2.0, 2.0, DegToRad(30.0), 1.3, DegToRad(5.0)}));
+  ASSERT_EQ(written.getWidth(), 640u);
+  ASSERT_EQ(written.getHeight(), 480u);
+  EXPECT_TRUE(written == expected);
+}
+
+TEST_F(RenderCli, SequenceFromATrajectoryWritesEverything) {
+  std::vector<StampedPose> poses;
+  for (int k = 0; k < 3; ++k) {
+    poses.push_back({0.5 * k, CamFromWorld({3.0 + k, 2.0, 0.4 * k, 1.3, DegToRad(4.0)}).inverse()});
+  }
+  const std::string tum = (dir_ / "in.txt").string();
+  std::ofstream(tum) << FormatTum(poses);
+  const fs::path out = dir_ / "seq";
+  const CommandRun run = Linetrack("--trajectory " + tum + " --out " + out.string());
+  ASSERT_EQ(run.code, 0) << run.err;
+  for (const char* name : {"frame_00000.png", "frame_00001.png", "frame_00002.png",
+                           "groundtruth.txt", "priors.csv", "camera.xml"}) {
+    EXPECT_TRUE(fs::exists(out / name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(out / "frame_00003.png"));
+  const std::vector<StampedPose> truth = ReadTum((out / "groundtruth.txt").string());
+  ASSERT_EQ(truth.size(), 3u);
+  EXPECT_LT((truth[2].world_from_cam.matrix() - poses[2].world_from_cam.matrix()).norm(), 1e-8);
+  const std::vector<PriorRecord> priors = ReadPriors((out / "priors.csv").string());
+  ASSERT_EQ(priors.size(), 3u);
+  EXPECT_NEAR(priors[0].pose.x, 3.0, 1e-6);  // odometry starts at the true pose
+  EXPECT_NEAR(priors[2].pose.tilt, DegToRad(4.0), 1e-6);
+  const CameraIntrinsics camera = ReadCameraXml((out / "camera.xml").string());
+  EXPECT_EQ(camera.width, 640);
+  EXPECT_DOUBLE_EQ(camera.px, 1000.0);
+  EXPECT_NE(run.err.find("rendered 3/3 frames"), std::string::npos);  // progress on stderr
+}
+
+TEST_F(RenderCli, HallLoopWithPanTilt) {
+  const fs::path out = dir_ / "loop";
+  const CommandRun run =
+      Linetrack("--path hall-loop --nav " + kNav +
+                " --frames 2 --pan-amplitude 20 --clutter 5 --out " + out.string());
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_TRUE(fs::exists(out / "frame_00001.png"));
+  EXPECT_EQ(ReadPriors((out / "priors.csv").string()).size(), 2u);
+}
+
+TEST_F(RenderCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
+  const std::string png = (dir_ / "x.png").string();
+  const std::string seq = (dir_ / "seq").string();
+  const std::string bad_tum = (dir_ / "bad.txt").string();
+  std::ofstream(bad_tum) << "0 1 1 1 0 0 0 1\n0.1 1 1 1 0 0 0\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--out " + png, "exactly one of"},
+      {"--pose 1,2 --out " + png, "--pose"},
+      {"--pose 1,2,3 --out " + (dir_ / "x.jpg").string(), ".png"},
+      {"--pose 1,2,3 --noise -1 --out " + png, "noise"},
+      {"--pose 1,2,3 --tilt 95 --out " + png, "--tilt"},
+      {"--path circle --out " + seq, "unknown path"},
+      {"--path hall-loop --nav " + kNav + " --speed 0 --out " + seq, "speed"},
+      {"--path hall-loop --nav /nonexistent.json --out " + seq, "/nonexistent.json"},
+      {"--trajectory " + bad_tum + " --out " + seq, "bad.txt:2:"},
+      {"--trajectory /nonexistent.txt --out " + seq, "/nonexistent.txt"},
+  };
+  for (const auto& [args, what] : cases) {
+    const CommandRun run = Linetrack(args);
+    EXPECT_EQ(run.code, 2) << args;
+    EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
+  EXPECT_FALSE(fs::exists(png));
+  EXPECT_FALSE(fs::exists(seq));
+}
+
+}  // namespace
+}  // namespace linetrack
