@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <regex>
 #include <sstream>
 
 #include "models/errors.h"
@@ -37,12 +36,18 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
-// Text of the first <tag>...</tag> inside `xml`, or nullopt.
+// Text of the first <tag>...</tag> inside `xml` (trimmed), or nullopt.
 std::optional<std::string> FirstElement(const std::string& xml, const std::string& tag) {
-  const std::regex re("<" + tag + ">\\s*([^<]*?)\\s*</" + tag + ">");
-  std::smatch m;
-  if (!std::regex_search(xml, m, re)) return std::nullopt;
-  return m[1].str();
+  const std::string open = "<" + tag + ">", close = "</" + tag + ">";
+  const size_t begin = xml.find(open);
+  if (begin == std::string::npos) return std::nullopt;
+  const size_t start = begin + open.size();
+  const size_t end = xml.find(close, start);
+  if (end == std::string::npos) return std::nullopt;
+  const std::string text = xml.substr(start, end - start);
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return std::string();
+  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
 }
 
 // Tracker settings files (<conf><camera><px>..</px>...) also carry intrinsics (ViSP samples).
