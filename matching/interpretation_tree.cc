@@ -39,6 +39,7 @@ class TreeSearch {
         FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
                                   std::max(min_width, prior_.heading.Width() / options_.max_bins));
     used_.assign(lines_.size(), false);
+    reachable_lines_.assign(lines_.size(), false);
     suffix_.assign(levels_.size() + 1, 0);
     regions_.resize(levels_.size() + 2);
     for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
@@ -117,8 +118,9 @@ class TreeSearch {
       return;
     }
     const Level& level = levels_[depth];
+    const bool vertical = edges_[level.edge].vertical;
     for (int line : level.lines) {
-      if (used_[line]) continue;
+      if (used_[line] || (vertical && VerticalsFull())) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
       FeasibleRegion& next = regions_[depth + 1];
       next = region;
@@ -126,13 +128,23 @@ class TreeSearch {
       next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
+      assigned_verticals_ += vertical ? 1 : 0;
       Search(depth + 1, next);
+      assigned_verticals_ -= vertical ? 1 : 0;
       assigned_.pop_back();
       used_[line] = false;
     }
     skipped_.push_back(static_cast<int>(depth));
     Search(depth + 1, region);
     skipped_.pop_back();
+  }
+
+  // The tree assigns at most options_.max_vertical_matches vertical correspondences: they are
+  // weakly constrained one by one (many similar vertical lines and edges), so once a few fix the
+  // pose with the non-vertical ones, the verification's guided matching finds the others.
+  bool VerticalsFull() const {
+    return options_.max_vertical_matches > 0 &&
+           assigned_verticals_ >= options_.max_vertical_matches;
   }
 
   // Inscribed-angle range of two vertical edges over the prior disk, computed once per pair.
@@ -147,22 +159,35 @@ class TreeSearch {
   }
 
   // Upper bound on the levels from `depth` on that can still be matched: those with an unused
-  // candidate whose unary heading interval meets the region's headings.
+  // candidate whose unary heading interval meets the region's headings, and no more than the
+  // distinct lines among those candidates (each line matches one edge).
   int Reachable(size_t depth, const FeasibleRegion& region) const {
     if (region.Empty()) return 0;
     const HeadingInterval h = region.Heading();
-    int count = 0;
+    int levels = 0, vertical_levels = 0;
+    std::fill(reachable_lines_.begin(), reachable_lines_.end(), false);
+    int lines = 0;
     for (size_t d = depth; d < levels_.size(); ++d) {
       const Level& level = levels_[d];
+      const bool vertical = edges_[level.edge].vertical;
+      if (vertical && VerticalsFull()) continue;
+      bool any = false;
       for (size_t c = 0; c < level.lines.size(); ++c) {
-        if (!used_[level.lines[c]] && level.headings[c].lo <= h.hi &&
-            level.headings[c].hi >= h.lo) {
-          ++count;
-          break;
+        const int line = level.lines[c];
+        if (used_[line] || level.headings[c].lo > h.hi || level.headings[c].hi < h.lo) continue;
+        any = true;
+        if (!reachable_lines_[line]) {
+          reachable_lines_[line] = true;
+          ++lines;
         }
       }
+      if (any) (vertical ? vertical_levels : levels) += 1;
     }
-    return count;
+    if (options_.max_vertical_matches > 0) {
+      vertical_levels =
+          std::min(vertical_levels, options_.max_vertical_matches - assigned_verticals_);
+    }
+    return std::min(levels + vertical_levels, lines);
   }
 
   // A leaf is kept only when no skipped edge could have been matched as well: every subset of a
@@ -170,6 +195,7 @@ class TreeSearch {
   bool IsMaximal(const FeasibleRegion& region) const {
     for (int depth : skipped_) {
       const Level& level = levels_[depth];
+      if (edges_[level.edge].vertical && VerticalsFull()) continue;
       for (int line : level.lines) {
         if (used_[line]) continue;
         maximal_scratch_ = region;
@@ -190,9 +216,11 @@ class TreeSearch {
   std::vector<Level> levels_;
   std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
+  mutable std::vector<bool> reachable_lines_;  // scratch of Reachable()
   std::vector<FeasibleRegion> regions_;  // per depth
   mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
+  int assigned_verticals_ = 0;
   std::vector<int> skipped_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };

@@ -20,6 +20,7 @@ struct InterpretationTreeOptions {
   double heading_bin_deg = 0.5;  // finest heading bins of the feasible region (degrees)
   int max_bins = 96;             // bins are split finer as the headings narrow, up to this
   int min_matches = 4;           // k: leaves with fewer correspondences are discarded
+  int max_vertical_matches = 0;  // vertical correspondences per hypothesis (0: no limit)
   int bound_slack = 2;           // branch and bound: leaves smaller than best - slack are pruned
   int max_nodes = 200000;        // search budget (deterministic)
   int max_hypotheses = 1000;     // leaves kept at most

@@ -90,17 +90,33 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
                               problem.tilt, &occlusion_, &prior,   area_};
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
-    // Leaves are verified as the search finds them; a plausible pose with m matched edges
-    // raises the bound to m - bound_slack (the truth's leaf holds nearly all its edges).
+    // Leaves are verified as the search finds them: the pose of the leaf's correspondences
+    // first (Levenberg-Marquardt), then guided matching from it -- unless that pose is within
+    // the duplicate tolerance of a leaf pose already verified, which would converge the same way.
+    // Branch and bound: once a leaf of m correspondences verifies plausibly, leaves smaller than
+    // m - bound_slack are pruned (the truth's leaf holds nearly all the edges the tree assigns).
     InterpretationTreeStats stats;
-    int best = 0;
+    int best_leaf = 0;
+    std::vector<Pose3Dof> leaf_poses;  // LM poses of the leaves verified in full
+    const VerificationOptions& vo = options_.verification;
     SearchInterpretationTree(
         edges, lines, prior, options_.tree,
         [&](const Hypothesis& h) {
-          verified.push_back(
-              VerifyHypothesis(context, h.pairs, h.region.Representative(), options_.verification));
-          if (verified.back().plausible) best = std::max(best, verified.back().matched_edges);
-          return best - options_.tree.bound_slack;
+          ++result.hypotheses;
+          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representative(), vo);
+          for (const Pose3Dof& seen : leaf_poses) {
+            if (std::hypot(seen.x - leaf.pose.x, seen.y - leaf.pose.y) < vo.duplicate_distance_m &&
+                std::abs(WrapAngle(seen.heading - leaf.pose.heading)) <
+                    DegToRad(vo.duplicate_heading_deg)) {
+              return best_leaf - options_.tree.bound_slack;
+            }
+          }
+          leaf_poses.push_back(leaf.pose);
+          verified.push_back(Rematch(context, leaf, vo));
+          if (verified.back().plausible) {
+            best_leaf = std::max(best_leaf, static_cast<int>(h.pairs.size()));
+          }
+          return best_leaf - options_.tree.bound_slack;
         },
         &stats);
     result.unary_candidates = stats.unary_candidates;
@@ -111,7 +127,9 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);
     result.samples = stats.samples;
   }
-  result.hypotheses = static_cast<int>(verified.size());
+  if (options_.method != MatchMethod::kInterpretationTree) {
+    result.hypotheses = static_cast<int>(verified.size());
+  }
   Decide(std::move(verified), context, edges, &result);
   return result;
 }

@@ -203,7 +203,7 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
   return result;
 }
 
-VerifiedPose VerifyHypothesis(const VerificationContext& context,
+VerifiedPose RefineHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options) {
   VerifiedPose result;
@@ -211,7 +211,13 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
   result.refinement = RefinePose(ToLineMatches(context, pairs), *context.camera, context.height,
                                  context.tilt, start, options.refinement);
   result.pose = result.refinement.pose;
-  return Rematch(context, result, options);
+  return result;
+}
+
+VerifiedPose VerifyHypothesis(const VerificationContext& context,
+                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const VerificationOptions& options) {
+  return Rematch(context, RefineHypothesis(context, pairs, start, options), options);
 }
 
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {

@@ -43,6 +43,9 @@ struct VerificationOptions {
   double ambiguity_distance_m = 0.3;
   double ambiguity_heading_deg = 5.0;
   double ambiguity_ratio = 0.8;
+  // Leaves whose own pose lies this close to a leaf already verified are not verified again.
+  double duplicate_distance_m = 0.05;
+  double duplicate_heading_deg = 0.5;
   int finalists = 24;
   PoseRefinementOptions refinement;
 
@@ -75,8 +78,14 @@ struct VerifiedPose {
   bool plausible = false;  // passed the RMS and observability checks
 };
 
-// Refines the pose of a hypothesis (pairs of edge/line indices) from `start`, then matches all
-// candidate edges to lines at that pose and re-estimates (guided rounds).
+// The pose of a hypothesis (pairs of edge/line indices) by Levenberg-Marquardt from `start`,
+// not yet re-matched nor scored.
+VerifiedPose RefineHypothesis(const VerificationContext& context,
+                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const VerificationOptions& options);
+
+// RefineHypothesis, then matches all candidate edges to lines at that pose and re-estimates
+// (guided rounds), and scores.
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options);
