@@ -7,5 +7,6 @@
 namespace linetrack::app {
 
 void AddModelInfo(CLI::App& cli, CommandAction* action);
+void AddBenchCapture(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
 
   app::CommandAction action;
   app::AddModelInfo(cli, &action);
+  app::AddBenchCapture(cli, &action);
 
   try {
     cli.parse(argc, argv);
