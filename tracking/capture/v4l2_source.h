@@ -20,7 +20,8 @@ struct V4l2SourceOptions {
 
 // A V4L2 device ("/dev/video0"). The constructor throws InputError naming the device when it
 // does not exist or cannot be opened. A failing acquisition returns kDeviceLost and the device
-// is re-opened on later calls.
+// is re-opened on later calls. Grab() has no timeout of its own: vpV4l2Grabber waits up to 30 s
+// for a frame from a stalled device (ViSP's select timeout).
 class V4l2Source : public FrameSource {
  public:
   V4l2Source(const std::string& device, const V4l2SourceOptions& options);
