@@ -91,6 +91,8 @@ TEST(SimulatedHead, NeverExceedsSpeedAccelerationOrJointLimits) {
   EXPECT_TRUE(pan_hit);
   EXPECT_TRUE(tilt_hit);
   EXPECT_EQ(state.pan, options.limits.pan_min);  // the second command drove it to the other end
+  EXPECT_EQ(state.tilt, options.limits.tilt_max);
+  EXPECT_FALSE(state.moving);  // both joints pressed against their limits
 }
 
 TEST(SimulatedHead, MoveToSettlesOnTheTarget) {

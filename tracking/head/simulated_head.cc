@@ -98,12 +98,16 @@ HeadResult SimulatedHead::Read(HeadState* state) {
   state->mode = active_.mode;
   state->pan_at_limit = pan_.at_limit;
   state->tilt_at_limit = tilt_.at_limit;
-  const bool still = pan_.rate == 0.0 && tilt_.rate == 0.0;
-  const bool on_target = active_.mode == HeadMode::kPosition && pan_.position == active_.pan &&
-                         tilt_.position == active_.tilt;
-  const bool zero_command =
-      active_.mode == HeadMode::kVelocity && active_.pan == 0.0 && active_.tilt == 0.0;
-  state->moving = !(still && (on_target || zero_command)) || !pending_.empty();
+  const HeadLimits& l = options_.limits;
+  // An axis moves when it has a rate, or is about to: a position target not reached yet, or a
+  // velocity command that its joint limit does not block.
+  auto axis_moving = [&](const AxisMotion& axis, double command, double min, double max) {
+    if (axis.rate != 0.0) return true;
+    if (active_.mode == HeadMode::kPosition) return axis.position != command;
+    return (command > 0.0 && axis.position < max) || (command < 0.0 && axis.position > min);
+  };
+  state->moving = !pending_.empty() || axis_moving(pan_, active_.pan, l.pan_min, l.pan_max) ||
+                  axis_moving(tilt_, active_.tilt, l.tilt_min, l.tilt_max);
   return HeadResult::Ok();
 }
 
