@@ -7,6 +7,7 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "tracking/head/head_factory.h"
 #include "tracking/head/ptu_driver.h"
 #include "tracking/head/ptu_emulator.h"
 #include "tracking/head/ptu_protocol.h"
@@ -274,6 +275,34 @@ TEST(PtuEmulator, AnswersInVerboseModeWithEcho) {
   EXPECT_EQ(reply, "PP3200 ! Maximum allowable Pan position is 3090");
   ASSERT_EQ(line.ReadLine(deadline, &reply, &why), SerialLine::ReadStatus::kLine) << why;
   EXPECT_EQ(reply, "XX ! Illegal Command");
+}
+
+TEST(HeadFactory, OpensPtuAndSimulatedHeads) {
+  EXPECT_EQ(ParseHeadSpec("sim").kind, HeadKind::kSim);
+  EXPECT_EQ(ParseHeadSpec("ptu:/dev/ttyUSB0").device, "/dev/ttyUSB0");
+  EXPECT_THROW(ParseHeadSpec("ptu:"), InputError);
+  EXPECT_THROW(ParseHeadSpec("biclops"), InputError);
+
+  HeadOptions options;
+  options.ptu.reply_timeout_s = kReplyTimeoutS;
+  const auto sim = OpenHead("sim", options);
+  EXPECT_NE(dynamic_cast<SimulatedHead*>(sim.get()), nullptr);
+
+  std::string why;
+  auto emulator = PtuEmulator::Start({}, &why);
+  ASSERT_TRUE(emulator) << why;
+  const auto ptu = OpenHead("ptu:" + emulator->device_path(), options);
+  EXPECT_NE(dynamic_cast<PtuDriver*>(ptu.get()), nullptr);
+  EXPECT_THROW(OpenHead("ptu:/dev/ttyLINETRACK-none", options), InputError);
+  emulator->SetResponsive(false);
+  try {
+    OpenHead("ptu:" + emulator->device_path(), options);
+    ADD_FAILURE() << "a silent unit must not open";
+  } catch (const InputError& e) {
+    ADD_FAILURE() << "a silent unit is a failed job, not bad input: " << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no reply"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
