@@ -9,5 +9,6 @@ namespace linetrack::app {
 void AddModelInfo(CLI::App& cli, CommandAction* action);
 void AddLocalize(CLI::App& cli, CommandAction* action);
 void AddRender(CLI::App& cli, CommandAction* action);
+void AddBenchCapture(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

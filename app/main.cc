@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   app::AddModelInfo(cli, &action);
   app::AddLocalize(cli, &action);
   app::AddRender(cli, &action);
+  app::AddBenchCapture(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -17,15 +17,20 @@ function(linetrack_add_library)
 endfunction()
 
 # linetrack_add_test(NAME models_cao_reader SRCS cao_reader_test.cc LINK linetrack_models)
-# Test names read like `models.CaoReader.Parses...` in ctest.
+# Test names read like `models.CaoReader.Parses...` in ctest. Optional PROPERTIES are ctest
+# properties for every test of the binary (e.g. LABELS aravis RESOURCE_LOCK gige_port).
 function(linetrack_add_test)
-  cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK;PROPERTIES" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
     LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")
   linetrack_strict_warnings(${ARG_NAME})
+  set(extra_properties)
+  if(ARG_PROPERTIES)
+    set(extra_properties PROPERTIES ${ARG_PROPERTIES})
+  endif()
   gtest_discover_tests(${ARG_NAME} TEST_PREFIX "${ARG_PREFIX}." DISCOVERY_TIMEOUT 60
-    WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+    WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR} ${extra_properties})
 endfunction()
