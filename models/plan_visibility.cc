@@ -61,7 +61,7 @@ std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double 
       if (std::min(p.x(), q.x()) > s0 || std::max(p.x(), q.x()) < s1) continue;
       const double slope = (q.y() - p.y()) / (q.x() - p.x());
       const double za = p.y() + slope * (s0 - p.x()), zb = p.y() + slope * (s1 - p.x());
-      if (std::max(za, zb) < z_lo || std::min(za, zb) > z_hi) continue;
+      if (std::max(za, zb) <= z_lo || std::min(za, zb) >= z_hi) continue;  // outside the band
       double lo = s0, hi = s1;
       if (slope != 0.0) {
         const double sa = s0 + (z_lo - za) / slope, sb = s0 + (z_hi - za) / slope;
@@ -90,8 +90,10 @@ std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double 
   return covered;
 }
 
-std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance) {
-  const double z_lo = model.BoxMin().z() + tolerance, z_hi = model.BoxMax().z() - tolerance;
+std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
+                                          double camera_top) {
+  const double z_lo = model.BoxMin().z() + tolerance;
+  const double z_hi = std::max(model.BoxMax().z(), camera_top) - tolerance;
   std::vector<Segment2> pieces;
   if (!(z_hi > z_lo)) return pieces;
   for (const ModelFace& face : model.faces()) {

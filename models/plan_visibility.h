@@ -14,10 +14,11 @@
 namespace linetrack {
 
 // Floor-plan segments of the parts of the vertical faces that cover the model's whole height
-// [z_min + tolerance, z_max - tolerance] (metres): a sight line between two points inside that
-// height range whose plan crosses such a segment hits the face. A face with a door cut out
-// occludes on both sides of the door only. Collinear pieces that touch are merged.
-std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance);
+// [z_min + tolerance, max(z_max, camera_top) - tolerance] (world z, metres): a sight line between
+// two points inside that height range whose plan crosses such a segment hits the face. A face
+// with a door cut out occludes on both sides of the door only. Collinear touching pieces merge.
+std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
+                                          double camera_top);
 
 // Intervals of s where the polygon `s_z` (points (s, z)) covers the whole band [z_lo, z_hi].
 std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi);

@@ -244,6 +244,10 @@ bool ViewInvariantRegionsOptions::Check(std::string* why) const {
     *why = "full_height_tolerance must be in [0, 1) metres";
     return false;
   }
+  if (!std::isfinite(camera_top)) {
+    *why = "camera_top must be finite (metres)";
+    return false;
+  }
   if (!(grid_pitch == 0.0 || (grid_pitch >= 0.05 && grid_pitch <= 1e3))) {
     *why = "grid_pitch must be 0 (no grid) or in [0.05, 1000] metres";
     return false;
@@ -267,7 +271,7 @@ ViewInvariantRegions ViewInvariantRegions::Build(const WireframeModel& model,
     vir.footprints_.push_back({footprint.front(), footprint.back()});
   }
   if (area.outer().vertices.size() < 3) return vir;
-  vir.occluders_ = FullHeightOccluders(model, options.full_height_tolerance);
+  vir.occluders_ = FullHeightOccluders(model, options.full_height_tolerance, options.camera_top);
   std::vector<Cell> cells = InitialCells(area, vir.occluders_, options.grid_pitch);
   if (options.event_rays) {
     for (const Segment2& ray : EventRays(model, vir.occluders_, area)) {

@@ -46,6 +46,10 @@ struct ViewInvariantRegionsOptions {
   // Only faces spanning the model's whole height (floor to ceiling) occlude in the plan; lower
   // faces are conservatively treated as transparent. Tolerance on that test (metres).
   double full_height_tolerance = 0.01;
+  // Highest camera position the lists must hold for (world z, metres): a face occludes only when
+  // it also reaches above it. The default 0 is below the top of a model standing on z = 0, so the
+  // model's top is used; raise it for cameras above low models.
+  double camera_top = 0.0;
   // Regions are also cut by a square grid of this pitch (metres; 0: no grid), which bounds their
   // size and so the width of their bearing ranges (the query's own disk test mostly does that).
   double grid_pitch = 0.0;
