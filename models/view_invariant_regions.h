@@ -65,6 +65,8 @@ struct ViewInvariantRegionsOptions {
 
 class ViewInvariantRegions {
  public:
+  // Regions of `area` and their visibility lists for `model` (docs/models.md); throws InputError
+  // naming the model when the options are invalid.
   static ViewInvariantRegions Build(const WireframeModel& model, const NavigableArea& area,
                                     const ViewInvariantRegionsOptions& options = {});
 
