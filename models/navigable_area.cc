@@ -7,17 +7,12 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "models/convex_polygon.h"
 #include "models/errors.h"
+#include "models/plan_arrangement.h"
 
 namespace linetrack {
 namespace {
-
-double DistanceToSegment(const Eigen::Vector2d& p, const Segment2& s) {
-  const Eigen::Vector2d d = s.b - s.a;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - s.a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (s.a + t * d - p).norm();
-}
 
 Polygon2 ReadRing(const nlohmann::json& ring, const std::string& path, const std::string& field) {
   if (!ring.is_array() || ring.size() < 3) {
@@ -39,14 +34,15 @@ Polygon2 ReadRing(const nlohmann::json& ring, const std::string& path, const std
   return polygon;
 }
 
-// Floor-plan segments of the model's vertical faces (the walls a camera keeps away from).
-std::vector<Segment2> WallSegments(const WireframeModel& model) {
-  std::vector<Segment2> walls;
+// Floor-plan footprints of the model's vertical faces (the walls), with the side they face.
+std::vector<PlanWall> PlanWalls(const WireframeModel& model) {
+  std::vector<PlanWall> walls;
   for (const ModelFace& face : model.faces()) {
-    if (!face.vertical) continue;
-    // The plan footprint of a vertical face is the segment between its extreme corners along
-    // the horizontal direction of its plane.
-    const Eigen::Vector2d along(-face.normal.y(), face.normal.x());
+    if (!face.vertical || face.Degenerate()) continue;
+    // The footprint of a vertical face is the segment between its extreme corners along the
+    // horizontal direction of its plane.
+    const Eigen::Vector2d normal = face.normal.head<2>().normalized();
+    const Eigen::Vector2d along(-normal.y(), normal.x());
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero();
     for (const Eigen::Vector3d& c : face.corners) {
@@ -54,9 +50,98 @@ std::vector<Segment2> WallSegments(const WireframeModel& model) {
       if (s < lo) lo = s, a = c.head<2>();
       if (s > hi) hi = s, b = c.head<2>();
     }
-    if (hi - lo > 1e-9) walls.push_back({a, b});
+    if (hi - lo > 1e-9) walls.push_back({{a, b}, normal});
   }
   return walls;
+}
+
+std::vector<Segment2> WallSegments(const WireframeModel& model) {
+  std::vector<Segment2> segments;
+  for (const PlanWall& wall : PlanWalls(model))
+    segments.push_back(wall.segment);
+  return segments;
+}
+
+// Footprints closer than this merge (metres), and faces smaller than this have no area (m^2).
+constexpr double kPlanTolerance = 1e-6;
+constexpr double kMinFootprintArea = 1e-6;
+// Margin around the model's plan when no walls enclose it (metres).
+constexpr double kOpenModelMargin = 2.0;
+
+Polygon2 CounterClockwise(Ring2 ring) {
+  if (RingSignedArea(ring) < 0.0) std::reverse(ring.begin(), ring.end());
+  return Polygon2{std::move(ring)};
+}
+
+// The outer boundary: the largest bounded face of the wall arrangement whose walls mostly face
+// into it (a room's walls face inwards); nullptr when no such face exists.
+const PlanCycle* Enclosure(const PlanArrangement& walls) {
+  const PlanCycle* best = nullptr;
+  for (const PlanCycle& cycle : walls.cycles()) {
+    if (cycle.signed_area <= kMinFootprintArea || cycle.facing_length <= 0.5 * cycle.length) {
+      continue;
+    }
+    if (best == nullptr || cycle.signed_area > best->signed_area) best = &cycle;
+  }
+  return best;
+}
+
+// Obstacles inside `outer`: the footprints of the closed wall loops not connected to the outer
+// boundary (pillars, free-standing boxes), outermost first, nested ones dropped.
+std::vector<Polygon2> ClosedFootprintsInside(const PlanArrangement& walls, const Polygon2& outer,
+                                             int outer_component) {
+  std::vector<Polygon2> footprints;
+  for (const PlanCycle& cycle : walls.cycles()) {
+    // A component's outer boundary is its one clockwise cycle.
+    if (cycle.signed_area >= -kMinFootprintArea || cycle.component == outer_component) continue;
+    Polygon2 footprint = CounterClockwise(walls.CycleRing(cycle));
+    if (footprint.vertices.size() < 3 || footprint.SignedArea() < kMinFootprintArea) continue;
+    if (outer.Contains(footprint.vertices.front())) footprints.push_back(std::move(footprint));
+  }
+  std::sort(footprints.begin(), footprints.end(),
+            [](const Polygon2& a, const Polygon2& b) { return a.SignedArea() > b.SignedArea(); });
+  std::vector<Polygon2> holes;
+  for (Polygon2& footprint : footprints) {
+    const bool nested = std::any_of(holes.begin(), holes.end(), [&](const Polygon2& hole) {
+      return hole.Contains(footprint.vertices.front());
+    });
+    if (!nested) holes.push_back(std::move(footprint));
+  }
+  return holes;
+}
+
+// The floor enclosed by the walls minus the closed obstacles in it; without enclosing walls the
+// model's plan bounding box grown by kOpenModelMargin, minus the closed footprints.
+NavigableArea DeriveFromWalls(const WireframeModel& model, double clearance) {
+  if (model.vertices().empty()) {
+    throw InputError(Located(model.path(), 0, "the model has no points: no navigable area"));
+  }
+  const std::vector<PlanWall> plan_walls = PlanWalls(model);
+  const PlanArrangement walls = PlanArrangement::Build(plan_walls, kPlanTolerance);
+  const PlanCycle* enclosure = Enclosure(walls);
+  Polygon2 outer;
+  std::string source;
+  int outer_component = -1;
+  if (enclosure != nullptr) {
+    outer = CounterClockwise(walls.CycleRing(*enclosure));
+    outer_component = enclosure->component;
+    source = "walls (" + std::to_string(plan_walls.size()) + " faces)";
+  }
+  if (outer.vertices.size() < 3) {
+    const Eigen::Vector2d lo =
+        model.BoxMin().head<2>() - Eigen::Vector2d::Constant(kOpenModelMargin);
+    const Eigen::Vector2d hi =
+        model.BoxMax().head<2>() + Eigen::Vector2d::Constant(kOpenModelMargin);
+    outer.vertices = {lo, {hi.x(), lo.y()}, hi, {lo.x(), hi.y()}};
+    outer_component = -1;
+    source = "bounding box + 2 m (no enclosing walls)";
+  }
+  std::vector<Polygon2> holes = ClosedFootprintsInside(walls, outer, outer_component);
+  std::vector<Segment2> segments;
+  for (const PlanWall& wall : plan_walls)
+    segments.push_back(wall.segment);
+  return NavigableArea::FromPolygons(std::move(outer), std::move(holes), std::move(segments),
+                                     clearance, source);
 }
 
 NavigableArea FromSidecar(const WireframeModel& model, const std::string& path,
@@ -95,24 +180,11 @@ NavigableArea FromSidecar(const WireframeModel& model, const std::string& path,
 }  // namespace
 
 double Polygon2::SignedArea() const {
-  double twice = 0.0;
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    twice += Cross2(vertices[i], vertices[(i + 1) % vertices.size()]);
-  }
-  return 0.5 * twice;
+  return RingSignedArea(vertices);
 }
 
 bool Polygon2::Contains(const Eigen::Vector2d& p) const {
-  bool inside = false;
-  for (size_t i = 0, j = vertices.size() - 1; i < vertices.size(); j = i++) {
-    const Eigen::Vector2d& a = vertices[i];
-    const Eigen::Vector2d& b = vertices[j];
-    if ((a.y() > p.y()) != (b.y() > p.y())) {
-      const double x = a.x() + (p.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
-      if (p.x() < x) inside = !inside;
-    }
-  }
-  return inside;
+  return RingContains(vertices, p);
 }
 
 bool NavigableAreaOptions::Check(std::string* why) const {
@@ -147,9 +219,7 @@ NavigableArea NavigableArea::FromModel(const WireframeModel& model,
     if (std::filesystem::exists(candidate, ec)) sidecar = candidate.string();
   }
   if (!sidecar.empty()) return FromSidecar(model, sidecar, options.clearance);
-  throw InputError(Located(model.path(), 0,
-                           "no navigable-area file next to the model (derivation from the walls "
-                           "is not implemented yet)"));
+  return DeriveFromWalls(model, options.clearance);
 }
 
 bool NavigableArea::InsideWalls(const Eigen::Vector2d& p, double margin) const {

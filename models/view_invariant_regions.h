@@ -46,26 +46,55 @@ struct ViewInvariantRegionsOptions {
   // Only faces spanning the model's whole height (floor to ceiling) occlude in the plan; lower
   // faces are conservatively treated as transparent. Tolerance on that test (metres).
   double full_height_tolerance = 0.01;
+  // Highest camera position the lists must hold for (world z, metres): a face occludes only when
+  // it also reaches above it. The default 0 is below the top of a model standing on z = 0, so the
+  // model's top is used; raise it for cameras above low models.
+  double camera_top = 0.0;
+  // Regions are also cut by a square grid of this pitch (metres; 0: no grid), which bounds their
+  // size and so the width of their bearing ranges (the query's own disk test mostly does that).
+  double grid_pitch = 0.0;
+  // Cut by the event rays (from an occluding vertex away from each model vertex it can hide, up
+  // to the next wall; Simsarian et al.), not only by the lines of walls and area boundaries.
+  bool event_rays = true;
+  // An edge counts as hidden only when the occluders block every sight line to it by at least
+  // this much (metres); keeps the lists conservative against rounding and grazing sight lines.
+  double hidden_margin = 1e-3;
 
   bool Check(std::string* why) const;
 };
 
 class ViewInvariantRegions {
  public:
+  // Regions of `area` and their visibility lists for `model` (docs/models.md); throws InputError
+  // naming the model when the options are invalid.
   static ViewInvariantRegions Build(const WireframeModel& model, const NavigableArea& area,
                                     const ViewInvariantRegionsOptions& options = {});
 
   const std::vector<ViewRegion>& regions() const { return regions_; }
   int size() const { return static_cast<int>(regions_.size()); }
+  // Floor-plan segments of the full-height faces, the occluders the lists were built with.
+  const std::vector<Segment2>& occluders() const { return occluders_; }
+  // Convex pieces of the closed loops of occluders no camera can be inside (pillars, boxes).
+  const std::vector<Polygon2>& solids() const { return solids_; }
 
   // Edges possibly visible from the query (sorted ids, each once): the union of the visibility
   // lists of the regions meeting the disk, keeping an edge when its bearing range meets
-  // [heading - margin - half_width, heading + margin + half_width]. Conservative: an edge that
-  // ray casting finds visible from a pose inside the query is never missing.
+  // [heading - margin - half_width, heading + margin + half_width], and so do the bearings from
+  // the disk itself to the edge. Conservative: an edge that ray casting finds visible from a pose
+  // inside the query (position in the navigable area, camera height between the model's floor
+  // and top) is never missing. Throws InputError on a non-finite or negative field.
   std::vector<int> Query(const VisibilityQuery& query) const;
 
  private:
+  // Fills the grid below from the regions' bounding boxes.
+  void BuildGrid(const NavigableArea& area);
+
   std::vector<ViewRegion> regions_;
+  std::vector<Segment2> occluders_;
+  std::vector<Polygon2> solids_;
+  int num_edges_ = 0;
+  // Floor-plan footprint of each edge (a == b for a vertical edge), for the disk's own bearings.
+  std::vector<Segment2> footprints_;
   // A uniform grid over the area's bounds listing the regions meeting each cell.
   Eigen::Vector2d grid_origin_ = Eigen::Vector2d::Zero();
   double grid_cell_ = 1.0;
@@ -74,8 +103,10 @@ class ViewInvariantRegions {
 };
 
 // Largest |bearing - heading| (radians) of a floor-plane bearing seen anywhere in an image of
-// `camera` at any tilt in [tilt_min, tilt_max] (radians); pi when the image may contain the nadir
-// or zenith. In the level frame a ray m has bearing offset atan2(mL_x, mL_z).
+// `camera` at any tilt in [tilt_min, tilt_max] (radians, within +-pi/2); pi when the image may
+// contain the nadir or zenith. In the level frame a ray m has bearing offset atan2(mL_x, mL_z).
+// The image is the pixel rectangle [0, width - 1] x [0, height - 1] (distorted when the camera
+// has distortion). Throws InputError when the camera or the tilt interval is invalid.
 double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max);
 
 }  // namespace linetrack

@@ -1,13 +1,19 @@
 // `linetrack model-info MODEL.cao [--json]`: what the model holds and what the matcher will use.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
 #include <sstream>
 
 #include "app/commands.h"
+#include "models/camera.h"
+#include "models/geometry.h"
 #include "models/navigable_area.h"
 #include "models/view_invariant_regions.h"
 #include "models/wireframe.h"
@@ -21,7 +27,59 @@ struct ModelInfoOptions {
   double clearance = NavigableAreaOptions().clearance;
   double vertical_tolerance_deg = WireframeOptions().vertical_tolerance_deg;
   bool json = false;
+  // Benchmark of the VIR query: random priors in the navigable area (0: none).
+  int queries = 0;
+  double query_radius = 0.5;       // delta_t, metres (the paper's QI2)
+  double query_margin_deg = 15.0;  // delta_phi, degrees
 };
+
+// Figures of the VIR query over seeded random priors, for the paper's synthetic camera
+// (640x480 px, f = 1000 px) at tilts 0..20 degrees.
+struct QueryStats {
+  double mean_kept = 0.0;
+  double selectivity = 0.0;  // mean kept / edge count
+  double mean_us = 0.0;
+  double median_us = 0.0;
+};
+
+QueryStats BenchmarkQueries(const ViewInvariantRegions& regions, const NavigableArea& area,
+                            int num_edges, const ModelInfoOptions& opt) {
+  CameraIntrinsics camera;
+  camera.width = 640;
+  camera.height = 480;
+  camera.px = camera.py = 1000.0;
+  camera.u0 = 320.0;
+  camera.v0 = 240.0;
+  const double half_width = BearingHalfWidth(camera, 0.0, DegToRad(20.0));
+  std::mt19937 rng(1u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector2d lo = area.BoundsMin(), size = area.BoundsMax() - lo;
+  std::vector<double> times_us;
+  double kept = 0.0;
+  for (int i = 0; i < opt.queries; ++i) {
+    VisibilityQuery query;
+    do {
+      query.centre = lo + Eigen::Vector2d(unit(rng) * size.x(), unit(rng) * size.y());
+    } while (!area.Contains(query.centre));
+    query.radius = opt.query_radius;
+    query.heading = kPi * (2.0 * unit(rng) - 1.0);
+    query.heading_margin = DegToRad(opt.query_margin_deg);
+    query.bearing_half_width = half_width;
+    const auto start = std::chrono::steady_clock::now();
+    kept += static_cast<double>(regions.Query(query).size());
+    times_us.push_back(
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+  QueryStats stats;
+  if (times_us.empty()) return stats;
+  stats.mean_kept = kept / opt.queries;
+  stats.selectivity = stats.mean_kept / std::max(1, num_edges);
+  stats.mean_us = std::accumulate(times_us.begin(), times_us.end(), 0.0) / times_us.size();
+  std::nth_element(times_us.begin(), times_us.begin() + times_us.size() / 2, times_us.end());
+  stats.median_us = times_us[times_us.size() / 2];
+  return stats;
+}
 
 nlohmann::json Point(const Eigen::Vector3d& p) {
   return {p.x(), p.y(), p.z()};
@@ -37,7 +95,13 @@ int RunModelInfo(const ModelInfoOptions& opt) {
   area_options.clearance = opt.clearance;
   area_options.sidecar_path = opt.sidecar_path;
   const NavigableArea area = NavigableArea::FromModel(model, area_options);
+  const auto build_start = std::chrono::steady_clock::now();
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
+  const double build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - build_start)
+          .count();
+  const QueryStats stats =
+      BenchmarkQueries(regions, area, static_cast<int>(model.edges().size()), opt);
 
   int face_edges = 0;
   for (const ModelEdge& e : model.edges())
@@ -59,8 +123,18 @@ int RunModelInfo(const ModelInfoOptions& opt) {
         {"holes", static_cast<int>(area.holes().size())},
         {"clearance_m", area.clearance()}}},
       {"view_invariant_regions", regions.size()},
+      {"view_invariant_regions_build_ms", build_ms},
       {"warnings", model.warnings()},
   };
+  if (opt.queries > 0) {
+    info["vir_queries"] = {{"count", opt.queries},
+                           {"radius_m", opt.query_radius},
+                           {"heading_margin_deg", opt.query_margin_deg},
+                           {"mean_edges_kept", stats.mean_kept},
+                           {"selectivity", stats.selectivity},
+                           {"mean_us", stats.mean_us},
+                           {"median_us", stats.median_us}};
+  }
   if (opt.json) {
     std::cout << info.dump(2) << std::endl;
     return kExitOk;
@@ -80,7 +154,17 @@ int RunModelInfo(const ModelInfoOptions& opt) {
       << "navigable area         " << area.Area() << " m2 from " << area.source() << ", "
       << area.outer().vertices.size() << " vertices, " << area.holes().size()
       << " obstacles, clearance " << area.clearance() << " m\n"
-      << "view-invariant regions " << regions.size() << "\n";
+      << "view-invariant regions " << regions.size() << " (built in " << build_ms << " ms; "
+      << regions.occluders().size() << " occluding wall segments, " << regions.solids().size()
+      << " solid obstacles)\n";
+  if (opt.queries > 0) {
+    out << "VIR queries            " << opt.queries << " random priors (" << opt.query_radius
+        << " m, " << opt.query_margin_deg
+        << " deg; 640x480 px, f 1000 px, tilt 0..20 deg): " << stats.mean_kept << " of "
+        << model.edges().size() << " edges kept (selectivity " << std::setprecision(3)
+        << stats.selectivity << std::setprecision(2) << "), " << stats.mean_us << " us mean, "
+        << stats.median_us << " us median\n";
+  }
   std::cout << out.str();
   return kExitOk;
 }
@@ -103,6 +187,18 @@ void AddModelInfo(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--vertical-tolerance", opt->vertical_tolerance_deg,
                   "Largest angle to the z axis of a vertical edge (degrees)")
+      ->capture_default_str();
+  cmd->add_option("--queries", opt->queries,
+                  "Also time this many random VIR queries in the navigable area and report the "
+                  "mean fraction of edges kept")
+      ->check(CLI::Range(0, 10000000))
+      ->capture_default_str();
+  cmd->add_option("--query-radius", opt->query_radius, "Prior disk radius delta_t (metres)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  cmd->add_option("--query-margin", opt->query_margin_deg,
+                  "Prior heading margin delta_phi (degrees)")
+      ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   cmd->callback([opt, action] { *action = [opt] { return RunModelInfo(*opt); }; });
 }

@@ -1,0 +1,274 @@
+#include "models/plan_visibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace linetrack {
+namespace {
+
+// Region points on an occluder's line count as touching it within this (metres), and a chord may
+// end this far past the occluder's ends (sight lines through its very end are measure zero).
+constexpr double kTouch = 1e-9;
+
+double Support(const Ring2& points, const Eigen::Vector2d& n) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& p : points)
+    best = std::max(best, n.dot(p));
+  return best;
+}
+
+// Outward normals of a counter-clockwise ring's edges (both normals for a two-point footprint).
+void AddEdgeNormals(const Ring2& ring, std::vector<Eigen::Vector2d>* normals) {
+  if (ring.size() == 2) {
+    const Eigen::Vector2d d = ring[1] - ring[0];
+    if (d.norm() > 0.0) {
+      normals->push_back(Eigen::Vector2d(d.y(), -d.x()).normalized());
+      normals->push_back(-normals->back());
+    }
+    return;
+  }
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const Eigen::Vector2d d = ring[(i + 1) % ring.size()] - ring[i];
+    if (d.norm() > 0.0) normals->push_back(Eigen::Vector2d(d.y(), -d.x()).normalized());
+  }
+}
+
+void AddDirection(const Eigen::Vector2d& v, std::vector<Eigen::Vector2d>* normals) {
+  const double norm = v.norm();
+  if (norm > 1e-15) normals->push_back(v / norm);
+}
+
+}  // namespace
+
+std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi) {
+  std::vector<double> xs;
+  for (const Eigen::Vector2d& p : s_z)
+    xs.push_back(p.x());
+  std::sort(xs.begin(), xs.end());
+  xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+  std::vector<std::pair<double, double>> covered;
+  for (size_t k = 0; k + 1 < xs.size(); ++k) {
+    const double s0 = xs[k], s1 = xs[k + 1];
+    if (s1 - s0 < 1e-9) continue;
+    // Inside the slab the polygon's edges are straight lines z(s); the band is covered where no
+    // edge passes through it and the band's middle is inside.
+    std::vector<std::pair<double, double>> blocked;
+    for (size_t i = 0; i < s_z.size(); ++i) {
+      const Eigen::Vector2d& p = s_z[i];
+      const Eigen::Vector2d& q = s_z[(i + 1) % s_z.size()];
+      if (std::min(p.x(), q.x()) > s0 || std::max(p.x(), q.x()) < s1) continue;
+      const double slope = (q.y() - p.y()) / (q.x() - p.x());
+      const double za = p.y() + slope * (s0 - p.x()), zb = p.y() + slope * (s1 - p.x());
+      if (std::max(za, zb) <= z_lo || std::min(za, zb) >= z_hi) continue;  // outside the band
+      double lo = s0, hi = s1;
+      if (slope != 0.0) {
+        const double sa = s0 + (z_lo - za) / slope, sb = s0 + (z_hi - za) / slope;
+        lo = std::max(s0, std::min(sa, sb));
+        hi = std::min(s1, std::max(sa, sb));
+      }
+      blocked.emplace_back(lo, hi);
+    }
+    std::sort(blocked.begin(), blocked.end());
+    double start = s0;
+    auto keep = [&](double a, double b) {
+      if (b - a < 1e-9) return;
+      if (!RingContains(s_z, {0.5 * (a + b), 0.5 * (z_lo + z_hi)})) return;
+      if (!covered.empty() && a - covered.back().second < 1e-9) {
+        covered.back().second = b;
+      } else {
+        covered.emplace_back(a, b);
+      }
+    };
+    for (const auto& [lo, hi] : blocked) {
+      keep(start, lo);
+      start = std::max(start, hi);
+    }
+    keep(start, s1);
+  }
+  return covered;
+}
+
+std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
+                                          double camera_top) {
+  const double z_lo = model.BoxMin().z() + tolerance;
+  const double z_hi = std::max(model.BoxMax().z(), camera_top) - tolerance;
+  std::vector<Segment2> pieces;
+  if (!(z_hi > z_lo)) return pieces;
+  for (const ModelFace& face : model.faces()) {
+    if (!face.vertical || face.Degenerate()) continue;
+    const Eigen::Vector2d n = face.normal.head<2>().normalized();
+    const Eigen::Vector2d along(-n.y(), n.x());
+    const Eigen::Vector2d origin = face.corners.front().head<2>();
+    Ring2 s_z;
+    for (const Eigen::Vector3d& c : face.corners) {
+      s_z.emplace_back(along.dot(c.head<2>() - origin), c.z());
+    }
+    for (const auto& [s0, s1] : FullHeightSpans(s_z, z_lo, z_hi)) {
+      pieces.push_back({origin + s0 * along, origin + s1 * along});
+    }
+  }
+  return MergeCollinear(pieces, 1e-6);
+}
+
+std::vector<Segment2> MergeCollinear(const std::vector<Segment2>& segments, double tolerance) {
+  struct Group {
+    Line2 line;
+    std::vector<std::pair<double, double>> spans;  // along line.Direction()
+  };
+  std::vector<Group> groups;
+  for (const Segment2& s : segments) {
+    if (s.Length() <= tolerance) continue;
+    Group* group = nullptr;
+    for (Group& g : groups) {
+      if (std::abs(g.line.SignedDistance(s.a)) <= tolerance &&
+          std::abs(g.line.SignedDistance(s.b)) <= tolerance) {
+        group = &g;
+        break;
+      }
+    }
+    if (group == nullptr) {
+      groups.push_back({Line2::Through(s.a, s.b), {}});
+      group = &groups.back();
+    }
+    const Eigen::Vector2d d = group->line.Direction();
+    group->spans.emplace_back(std::min(d.dot(s.a), d.dot(s.b)), std::max(d.dot(s.a), d.dot(s.b)));
+  }
+  std::vector<Segment2> merged;
+  for (Group& g : groups) {
+    std::sort(g.spans.begin(), g.spans.end());
+    const Eigen::Vector2d d = g.line.Direction(), base = g.line.offset * g.line.normal;
+    std::pair<double, double> run = g.spans.front();
+    auto emit = [&] { merged.push_back({base + run.first * d, base + run.second * d}); };
+    for (size_t i = 1; i < g.spans.size(); ++i) {
+      if (g.spans[i].first <= run.second + tolerance) {
+        run.second = std::max(run.second, g.spans[i].second);
+      } else {
+        emit();
+        run = g.spans[i];
+      }
+    }
+    emit();
+  }
+  return merged;
+}
+
+bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
+                  double margin) {
+  const Line2 line = Line2::Through(wall.a, wall.b);
+  double r_lo = std::numeric_limits<double>::infinity(), r_hi = -r_lo, f_lo = r_lo, f_hi = -r_lo;
+  for (const Eigen::Vector2d& r : region) {
+    r_lo = std::min(r_lo, line.SignedDistance(r));
+    r_hi = std::max(r_hi, line.SignedDistance(r));
+  }
+  for (const Eigen::Vector2d& f : footprint) {
+    f_lo = std::min(f_lo, line.SignedDistance(f));
+    f_hi = std::max(f_hi, line.SignedDistance(f));
+  }
+  double sign = 0.0;
+  if (r_lo >= -kTouch && f_hi <= -margin) sign = 1.0;
+  if (r_hi <= kTouch && f_lo >= margin) sign = -1.0;
+  if (sign == 0.0) return false;
+  // The chord conv(region + footprint) n line: region points on the line and the crossings of
+  // the segments between the two sides' vertices.
+  const Eigen::Vector2d d = line.Direction();
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Eigen::Vector2d& r : region) {
+    const double sr = sign * line.SignedDistance(r);
+    if (sr <= kTouch) {
+      lo = std::min(lo, d.dot(r));
+      hi = std::max(hi, d.dot(r));
+      continue;
+    }
+    for (const Eigen::Vector2d& f : footprint) {
+      const double sf = sign * line.SignedDistance(f);
+      const double x = d.dot(r + sr / (sr - sf) * (f - r));
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+  }
+  return lo >= d.dot(wall.a) - kTouch && hi <= d.dot(wall.b) + kTouch;
+}
+
+bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin) {
+  if (!ConvexInteriorsDisjoint(region, solid, kTouch)) return false;
+  // Cheap necessary condition first: the sight line between the centres crosses the solid.
+  Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& f : footprint)
+    f_mid += f / static_cast<double>(footprint.size());
+  const Segment2 centre_line{RingCentroid(region), f_mid};
+  double t0 = 0.0, t1 = 0.0;
+  if (!ClipSegmentToConvex(solid, centre_line, &t0, &t1) ||
+      (t1 - t0) * centre_line.Length() < margin) {
+    return false;
+  }
+  // g(n) = min(h_R(n), h_F(n)) - h_P(n) is piecewise a min of two sinusoids between the edge
+  // normals; its maximum lies at an edge normal, at a stationary point (n along r - v or f - v)
+  // or where the two sinusoids cross (n orthogonal to r - f).
+  std::vector<Eigen::Vector2d> normals;
+  AddEdgeNormals(region, &normals);
+  AddEdgeNormals(footprint, &normals);
+  AddEdgeNormals(solid, &normals);
+  for (const Eigen::Vector2d& v : solid) {
+    for (const Eigen::Vector2d& r : region)
+      AddDirection(r - v, &normals);
+    for (const Eigen::Vector2d& f : footprint)
+      AddDirection(f - v, &normals);
+  }
+  for (const Eigen::Vector2d& r : region) {
+    for (const Eigen::Vector2d& f : footprint) {
+      const Eigen::Vector2d d = r - f;
+      AddDirection({d.y(), -d.x()}, &normals);
+      AddDirection({-d.y(), d.x()}, &normals);
+    }
+  }
+  for (const Eigen::Vector2d& n : normals) {
+    const double h_solid = Support(solid, n);
+    if (std::min(Support(region, n), Support(footprint, n)) > h_solid - margin) return false;
+  }
+  return true;
+}
+
+BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
+  BearingRange range;
+  range.all = true;
+  if (footprint.size() == 1) {
+    if (ConvexContains(region, footprint[0], kTouch)) return range;
+  } else {
+    double t0 = 0.0, t1 = 0.0;
+    const Segment2 s{footprint[0], footprint[1]};
+    if (ClipSegmentToConvex(region, s, &t0, &t1)) return range;
+    for (size_t i = 0; i < region.size(); ++i) {
+      const Segment2 edge{region[i], region[(i + 1) % region.size()]};
+      if (DistanceToSegment(edge.a, s) <= kTouch || DistanceToSegment(s.a, edge) <= kTouch ||
+          DistanceToSegment(s.b, edge) <= kTouch) {
+        return range;
+      }
+    }
+  }
+  // The vectors q - p form a convex set without the origin, within pi of the centre direction;
+  // its extreme bearings are at differences of vertices.
+  Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& f : footprint)
+    f_mid += f / static_cast<double>(footprint.size());
+  const Eigen::Vector2d centre = f_mid - RingCentroid(region);
+  const double reference = std::atan2(centre.y(), centre.x());
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Eigen::Vector2d& f : footprint) {
+    for (const Eigen::Vector2d& r : region) {
+      const Eigen::Vector2d v = f - r;
+      if (v.norm() <= kTouch) return range;
+      const double a = WrapAngle(std::atan2(v.y(), v.x()) - reference);
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+    }
+  }
+  if (hi - lo >= kPi - 1e-9) return range;
+  range.all = false;
+  range.min = WrapAngle(reference + lo);
+  range.max = range.min + (hi - lo);
+  return range;
+}
+
+}  // namespace linetrack

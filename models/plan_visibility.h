@@ -1,0 +1,49 @@
+// Visibility in the floor plan, for the view-invariant regions: which faces occlude whatever the
+// camera height, conservative "hidden from every point of a region" tests, and the bearings under
+// which a region sees an edge. Regions are convex rings; an edge's footprint is its projection on
+// the floor plane, one point (vertical edge) or two.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "models/convex_polygon.h"
+#include "models/geometry.h"
+#include "models/wireframe.h"
+
+namespace linetrack {
+
+// Floor-plan segments of the parts of the vertical faces that cover the model's whole height
+// [z_min + tolerance, max(z_max, camera_top) - tolerance] (world z, metres): a sight line between
+// two points inside that height range whose plan crosses such a segment hits the face. A face
+// with a door cut out occludes on both sides of the door only. Collinear touching pieces merge.
+std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
+                                          double camera_top);
+
+// Intervals of s where the polygon `s_z` (points (s, z)) covers the whole band [z_lo, z_hi].
+std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi);
+
+// Merges collinear segments that overlap or touch (within `tolerance` metres) into maximal ones.
+std::vector<Segment2> MergeCollinear(const std::vector<Segment2>& segments, double tolerance);
+
+// True when the wall blocks every sight line from the region to the footprint: the region on one
+// side of the wall's line (touching it allowed), the footprint at least `margin` metres on the
+// other side, and the chord of their convex hull along the line inside the wall.
+bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall, double margin);
+
+// True when every sight line from the region to the footprint passes through the interior of the
+// convex `solid` (a closed loop of occluding walls), robustly: for every direction n,
+// max over the region or over the footprint of n.x stays `margin` metres below max over the
+// solid (no line separates the solid from a point of each). False when the region overlaps it.
+bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin);
+
+// World bearings (radians) of q - p for p in the region and q in the footprint: [min, max] with
+// min in (-pi, pi], max - min < pi; `all` when the footprint meets the region.
+struct BearingRange {
+  double min = 0.0;
+  double max = 0.0;
+  bool all = false;
+};
+BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint);
+
+}  // namespace linetrack

@@ -1,0 +1,184 @@
+// Queries of the view-invariant regions, and the bearing half-width of a camera's image.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "models/convex_polygon.h"
+#include "models/errors.h"
+#include "models/robot_pose.h"
+#include "models/view_invariant_regions.h"
+
+namespace linetrack {
+namespace {
+
+// True when the arcs [centre_a +- half_a] and [centre_b +- half_b] (radians) meet modulo 2 pi.
+bool ArcsMeet(double centre_a, double half_a, double centre_b, double half_b) {
+  double d = centre_a - centre_b;
+  d -= 2.0 * kPi * std::floor(d / (2.0 * kPi) + 0.5);  // to [-pi, pi), cheaper than remainder
+  return std::abs(d) <= half_a + half_b + 1e-12;
+}
+
+// Bearings of q - p for q on the footprint and p in the disk (centre, radius), as an arc
+// (centre, half width); false when they take every value (the footprint meets the disk).
+bool DiskBearings(const Segment2& footprint, const Eigen::Vector2d& centre, double radius,
+                  double* arc_centre, double* arc_half) {
+  if (DistanceToSegment(centre, footprint) <= radius + 1e-9) return false;
+  // q - p ranges over the convex hull of two disks around the footprint's ends, which misses the
+  // origin: its extreme bearings are the tangents to those disks.
+  const Eigen::Vector2d mid = footprint.Mid() - centre;
+  const double reference = std::atan2(mid.y(), mid.x());
+  double lo = kPi, hi = -kPi;
+  for (const Eigen::Vector2d& q : {footprint.a, footprint.b}) {
+    const Eigen::Vector2d d = q - centre;
+    const double towards = WrapAngle(std::atan2(d.y(), d.x()) - reference);
+    const double spread = std::asin(std::min(1.0, radius / d.norm()));
+    lo = std::min(lo, towards - spread);
+    hi = std::max(hi, towards + spread);
+  }
+  if (hi - lo >= kPi) return false;
+  *arc_centre = reference + 0.5 * (lo + hi);
+  *arc_half = 0.5 * (hi - lo);
+  return true;
+}
+
+}  // namespace
+
+void ViewInvariantRegions::BuildGrid(const NavigableArea& area) {
+  grid_.clear();
+  if (regions_.empty()) return;
+  grid_origin_ = area.BoundsMin();
+  const Eigen::Vector2d extent = area.BoundsMax() - grid_origin_;
+  // About one region per cell on average, cells no smaller than 5 cm.
+  grid_cell_ = std::max(0.05, std::sqrt(extent.x() * extent.y() / regions_.size()));
+  grid_cols_ = std::max(1, static_cast<int>(std::ceil(extent.x() / grid_cell_)));
+  grid_rows_ = std::max(1, static_cast<int>(std::ceil(extent.y() / grid_cell_)));
+  grid_.assign(static_cast<size_t>(grid_cols_) * grid_rows_, {});
+  auto col = [&](double x) {
+    return std::clamp(static_cast<int>(std::floor((x - grid_origin_.x()) / grid_cell_)), 0,
+                      grid_cols_ - 1);
+  };
+  auto row = [&](double y) {
+    return std::clamp(static_cast<int>(std::floor((y - grid_origin_.y()) / grid_cell_)), 0,
+                      grid_rows_ - 1);
+  };
+  for (size_t r = 0; r < regions_.size(); ++r) {
+    Eigen::Vector2d lo = regions_[r].polygon.vertices.front(), hi = lo;
+    for (const Eigen::Vector2d& p : regions_[r].polygon.vertices) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    for (int j = row(lo.y()); j <= row(hi.y()); ++j) {
+      for (int i = col(lo.x()); i <= col(hi.x()); ++i) {
+        grid_[static_cast<size_t>(j) * grid_cols_ + i].push_back(static_cast<int>(r));
+      }
+    }
+  }
+}
+
+std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const {
+  if (!query.centre.allFinite() || !std::isfinite(query.heading) ||
+      !(query.radius >= 0.0 && std::isfinite(query.radius)) || !(query.heading_margin >= 0.0) ||
+      !(query.bearing_half_width >= 0.0)) {
+    throw InputError(
+        "visibility query: centre and heading must be finite, radius, heading margin and "
+        "bearing half-width >= 0");
+  }
+  std::vector<int> ids;
+  if (grid_.empty()) return ids;
+  const double x0 = (query.centre.x() - query.radius - grid_origin_.x()) / grid_cell_;
+  const double x1 = (query.centre.x() + query.radius - grid_origin_.x()) / grid_cell_;
+  const double y0 = (query.centre.y() - query.radius - grid_origin_.y()) / grid_cell_;
+  const double y1 = (query.centre.y() + query.radius - grid_origin_.y()) / grid_cell_;
+  // Regions stick out of their grid cells by rounding only: a disk beyond the grid meets none.
+  if (x1 < -1e-9 || y1 < -1e-9 || x0 > grid_cols_ + 1e-9 || y0 > grid_rows_ + 1e-9) return ids;
+  const int i0 = std::clamp(static_cast<int>(std::floor(x0)), 0, grid_cols_ - 1);
+  const int i1 = std::clamp(static_cast<int>(std::floor(x1)), 0, grid_cols_ - 1);
+  const int j0 = std::clamp(static_cast<int>(std::floor(y0)), 0, grid_rows_ - 1);
+  const int j1 = std::clamp(static_cast<int>(std::floor(y1)), 0, grid_rows_ - 1);
+  std::vector<int> candidates;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const std::vector<int>& cell = grid_[static_cast<size_t>(j) * grid_cols_ + i];
+      candidates.insert(candidates.end(), cell.begin(), cell.end());
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+
+  const double half = query.heading_margin + query.bearing_half_width;
+  const bool any_bearing = half >= kPi;
+  // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
+  std::vector<char> state(num_edges_, 0);
+  for (int r : candidates) {
+    const ViewRegion& region = regions_[r];
+    if (DistanceToConvex(region.polygon.vertices, query.centre) > query.radius + 1e-9) continue;
+    for (const RegionEdge& e : region.visible) {
+      if (state[e.edge_id] != 0) continue;
+      if (any_bearing) {
+        state[e.edge_id] = 1;
+        continue;
+      }
+      if (!e.all_bearings &&
+          !ArcsMeet(0.5 * (e.bearing_min + e.bearing_max), 0.5 * (e.bearing_max - e.bearing_min),
+                    query.heading, half)) {
+        continue;  // another region may still see it under the query's bearings
+      }
+      double arc_centre = 0.0, arc_half = 0.0;
+      const bool narrow =
+          DiskBearings(footprints_[e.edge_id], query.centre, query.radius, &arc_centre, &arc_half);
+      state[e.edge_id] = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half) ? 1 : 2;
+    }
+  }
+  for (int id = 0; id < num_edges_; ++id) {
+    if (state[id] == 1) ids.push_back(id);
+  }
+  return ids;
+}
+
+double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max) {
+  std::string why;
+  if (!camera.Check(&why)) throw InputError("camera " + camera.name + ": " + why);
+  if (camera.width <= 0 || camera.height <= 0) {
+    throw InputError("camera " + camera.name + ": the image size is needed for its field of view");
+  }
+  if (!(std::isfinite(tilt_min) && std::isfinite(tilt_max) && tilt_min <= tilt_max &&
+        tilt_min >= -0.5 * kPi && tilt_max <= 0.5 * kPi)) {
+    throw InputError("tilt interval: need -90 <= tilt_min <= tilt_max <= 90 degrees");
+  }
+  // Box of the normalised coordinates (x, y) of the image's rays.
+  const Eigen::Vector2d far_corner(camera.width - 1.0, camera.height - 1.0);
+  Eigen::Vector2d lo = camera.Ray(Eigen::Vector2d::Zero()).head<2>();
+  Eigen::Vector2d hi = camera.Ray(far_corner).head<2>();
+  if (camera.has_distortion) {
+    // The undistorted image of the border, sampled every pixel, grown by half a pixel.
+    lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    auto add = [&](double u, double v) {
+      const Eigen::Vector2d m = camera.Ray(camera.Undistort({u, v})).head<2>();
+      lo = lo.cwiseMin(m);
+      hi = hi.cwiseMax(m);
+    };
+    for (int u = 0; u < camera.width; ++u)
+      add(u, 0.0), add(u, far_corner.y());
+    for (int v = 0; v < camera.height; ++v)
+      add(0.0, v), add(far_corner.x(), v);
+    const Eigen::Vector2d half_pixel(0.5 / camera.px, 0.5 / camera.py);
+    lo -= half_pixel;
+    hi += half_pixel;
+  }
+  // |w| = atan2(|m_x|, mL_z) with mL_z = cos t - sin t m_y grows with |m_x| and is monotone in
+  // m_y and, where mL_z > 0, in t over an interval: the extreme is at a corner of the box and an
+  // end of the tilt interval.
+  const double x_abs = std::max(std::abs(lo.x()), std::abs(hi.x()));
+  double widest = 0.0;
+  for (double tilt : {tilt_min, tilt_max}) {
+    for (double y : {lo.y(), hi.y()}) {
+      const double z = std::cos(tilt) - std::sin(tilt) * y;
+      if (z <= 0.0) return kPi;
+      widest = std::max(widest, std::atan2(x_abs, z));
+    }
+  }
+  return widest;
+}
+
+}  // namespace linetrack

@@ -1,0 +1,218 @@
+// Floor-plan geometry under the navigable area and the VIRs: convex rings, the wall arrangement,
+// full-height occluders, and the hidden/bearing tests against brute-force sampling.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "models/convex_polygon.h"
+#include "models/plan_arrangement.h"
+#include "models/plan_visibility.h"
+
+namespace linetrack {
+namespace {
+
+constexpr double kTol = 1e-9;
+constexpr double kMarginM = 1e-3;
+
+Ring2 Box(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
+
+TEST(ConvexRing, SplitByALineKeepsTheArea) {
+  Ring2 left, right;
+  ASSERT_TRUE(SplitConvex(Box(0, 0, 1, 1), {Eigen::Vector2d::UnitX(), 0.25}, 1e-12, &right, &left));
+  EXPECT_NEAR(RingSignedArea(left), 0.25, kTol);
+  EXPECT_NEAR(RingSignedArea(right), 0.75, kTol);
+  EXPECT_FALSE(SplitConvex(Box(0, 0, 1, 1), {Eigen::Vector2d::UnitX(), 2.0}, 1e-12, &right, &left));
+  EXPECT_FALSE(SplitConvex(Box(0, 0, 1, 1), {Eigen::Vector2d::UnitX(), 1.0}, 1e-12, &right, &left));
+}
+
+TEST(ConvexRing, ClipsASegment) {
+  double t0 = 0.0, t1 = 0.0;
+  ASSERT_TRUE(ClipSegmentToConvex(Box(0, 0, 1, 1), {{-1.0, 0.5}, {3.0, 0.5}}, &t0, &t1));
+  EXPECT_NEAR(t0, 0.25, kTol);
+  EXPECT_NEAR(t1, 0.5, kTol);
+  EXPECT_FALSE(ClipSegmentToConvex(Box(0, 0, 1, 1), {{-1.0, 1.5}, {3.0, 1.5}}, &t0, &t1));
+  EXPECT_NEAR(DistanceToConvex(Box(0, 0, 1, 1), {2.0, 0.5}), 1.0, kTol);
+  EXPECT_EQ(DistanceToConvex(Box(0, 0, 1, 1), {0.3, 0.5}), 0.0);
+}
+
+TEST(ConvexRing, PiecesOfAnLShapeAreConvexAndCoverIt) {
+  const Ring2 l_shape = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const std::vector<Ring2> pieces = ConvexPieces(l_shape);
+  ASSERT_FALSE(pieces.empty());
+  EXPECT_LE(pieces.size(), 3u);
+  double area = 0.0;
+  for (const Ring2& piece : pieces) {
+    EXPECT_TRUE(IsConvexRing(piece));
+    area += RingSignedArea(piece);
+  }
+  EXPECT_NEAR(area, 3.0, kTol);
+}
+
+TEST(ConvexRing, SimplifyDropsSpikesAndStraightVertices) {
+  // A square with a straight-through vertex on its south side and a spike into it from the north.
+  const Ring2 ring = {{0, 0}, {1, 0}, {2, 0}, {2, 2}, {1, 2}, {1, 1}, {1, 2}, {0, 2}};
+  const Ring2 simple = SimplifyRing(ring, 1e-9);
+  EXPECT_EQ(simple.size(), 4u);
+  EXPECT_NEAR(RingSignedArea(simple), 4.0, kTol);
+}
+
+TEST(PlanArrangement, RoomWithAPartitionHasOneInwardFacingFace) {
+  // A 4 x 3 room (walls facing in) and a one-sided partition from the south wall.
+  const Ring2 room = Box(0, 0, 4, 3);
+  std::vector<PlanWall> walls;
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector2d a = room[i], b = room[(i + 1) % 4];
+    const Eigen::Vector2d d = (b - a).normalized();
+    walls.push_back({{a, b}, {-d.y(), d.x()}});  // the left of a -> b is inside
+  }
+  walls.push_back({{{2.0, 0.0}, {2.0, 1.5}}, {1.0, 0.0}});
+  const PlanArrangement arrangement = PlanArrangement::Build(walls, 1e-9);
+  EXPECT_EQ(arrangement.vertices().size(), 6u);  // corners, the T junction, the partition's end
+  EXPECT_EQ(arrangement.edges().size(), 6u);
+  EXPECT_EQ(arrangement.num_components(), 1);
+  int bounded = 0;
+  for (const PlanCycle& cycle : arrangement.cycles()) {
+    if (cycle.signed_area <= 0.0) continue;
+    ++bounded;
+    EXPECT_NEAR(cycle.signed_area, 12.0, kTol);
+    EXPECT_NEAR(cycle.length, 14.0 + 3.0, kTol);  // the partition is walked on both sides
+    EXPECT_NEAR(cycle.facing_length, 14.0 + 1.5, kTol);
+    EXPECT_EQ(arrangement.CycleRing(cycle).size(), 4u);  // the partition is a spike, dropped
+  }
+  EXPECT_EQ(bounded, 1);
+}
+
+TEST(FullHeight, ADoorCutOutLeavesTheWallOnBothSides) {
+  // A 3 m wide, 3 m high wall face with a 1 m wide, 2.1 m high door, as one polygon (s, z).
+  const Ring2 wall = {{0, 0}, {1, 0}, {1, 2.1}, {2, 2.1}, {2, 0}, {3, 0}, {3, 3}, {0, 3}};
+  const auto spans = FullHeightSpans(wall, 0.01, 2.99);
+  ASSERT_EQ(spans.size(), 2u);
+  EXPECT_NEAR(spans[0].first, 0.0, kTol);
+  EXPECT_NEAR(spans[0].second, 1.0, kTol);
+  EXPECT_NEAR(spans[1].first, 2.0, kTol);
+  EXPECT_NEAR(spans[1].second, 3.0, kTol);
+  // A gable wall (a pentagon) covers the band [0, 3] only where its roof line is above 3 m.
+  const Ring2 gable = {{0, 0}, {4, 0}, {4, 2}, {2, 4}, {0, 2}};
+  const auto gable_spans = FullHeightSpans(gable, 0.0, 3.0);
+  ASSERT_EQ(gable_spans.size(), 1u);
+  EXPECT_NEAR(gable_spans[0].first, 1.0, kTol);
+  EXPECT_NEAR(gable_spans[0].second, 3.0, kTol);
+  EXPECT_TRUE(FullHeightSpans(Box(0, 0, 2, 1.8), 0.01, 2.49).empty());  // a cabinet side
+}
+
+TEST(PlanVisibility, MergesCollinearPieces) {
+  const std::vector<Segment2> merged = MergeCollinear(
+      {{{0, 0}, {1, 0}}, {{2, 0}, {1, 0}}, {{3, 0}, {4, 0}}, {{0, 1}, {1, 1}}}, 1e-9);
+  EXPECT_EQ(merged.size(), 3u);  // 0..2 and 3..4 on y = 0, 0..1 on y = 1
+}
+
+TEST(PlanVisibility, WallHidesWhatIsBehindIt) {
+  const Ring2 region = Box(0, 0, 1, 1);
+  const Segment2 wall{{-1.0, 2.0}, {3.0, 2.0}};
+  EXPECT_TRUE(HiddenByWall(region, {{0.5, 3.0}}, wall, kMarginM));
+  EXPECT_TRUE(HiddenByWall(region, {{-0.5, 3.0}, {1.5, 3.0}}, wall, kMarginM));
+  EXPECT_FALSE(HiddenByWall(region, {{5.0, 3.0}}, wall, kMarginM));  // seen past the wall's end
+  EXPECT_FALSE(HiddenByWall(region, {{0.5, 2.0}}, wall, kMarginM));  // on the wall itself
+  EXPECT_FALSE(HiddenByWall(region, {{0.5, 1.5}}, wall, kMarginM));  // in front of it
+  // A region touching the wall's line, within the wall, is still on one side.
+  EXPECT_TRUE(HiddenByWall(Box(0, 1, 1, 2), {{0.5, 3.0}}, wall, kMarginM));
+}
+
+// Uniform points of a convex ring (rejection from its box).
+Eigen::Vector2d PointIn(const Ring2& ring, std::mt19937* rng) {
+  Eigen::Vector2d lo = ring[0], hi = ring[0];
+  for (const Eigen::Vector2d& p : ring)
+    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y());
+  for (;;) {
+    const Eigen::Vector2d p(ux(*rng), uy(*rng));
+    if (ConvexContains(ring, p)) return p;
+  }
+}
+
+// A random convex ring: the hull-ordered corners of a random box rotated, around `centre`.
+Ring2 RandomBox(const Eigen::Vector2d& centre, double size, std::mt19937* rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double w = size * (0.2 + unit(*rng)), h = size * (0.2 + unit(*rng));
+  const double a = 2.0 * kPi * unit(*rng);
+  const Eigen::Vector2d u(std::cos(a), std::sin(a)), v(-u.y(), u.x());
+  return {centre - w * u - h * v, centre + w * u - h * v, centre + w * u + h * v,
+          centre - w * u + h * v};
+}
+
+TEST(PlanVisibility, HiddenTestsAgreeWithSampledSightLines) {
+  std::mt19937 rng(5u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int hidden_by_solid = 0, hidden_by_wall = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Ring2 region = RandomBox({0.0, 0.0}, 0.5, &rng);
+    const Ring2 solid = RandomBox({3.0, 4.0 * unit(rng) - 2.0}, 1.0, &rng);
+    const Eigen::Vector2d f0(6.0 + 2.0 * unit(rng), 6.0 * unit(rng) - 3.0);
+    const Ring2 footprint =
+        trial % 2 ? Ring2{f0} : Ring2{f0, f0 + Eigen::Vector2d(unit(rng) - 0.5, unit(rng) - 0.5)};
+    const Segment2 wall{solid[0], solid[2]};  // a diagonal of the solid as a thin wall
+    const bool by_solid = HiddenBySolid(region, footprint, solid, kMarginM);
+    const bool by_wall = HiddenByWall(region, footprint, wall, kMarginM);
+    hidden_by_solid += by_solid;
+    hidden_by_wall += by_wall;
+    if (!by_solid && !by_wall) continue;
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector2d p = k < 4 ? region[k] : PointIn(region, &rng);
+      const Eigen::Vector2d q = footprint.size() == 1
+                                    ? footprint[0]
+                                    : footprint[0] + unit(rng) * (footprint[1] - footprint[0]);
+      double t0 = 0.0, t1 = 0.0;
+      if (by_solid) {
+        ASSERT_TRUE(ClipSegmentToConvex(solid, {p, q}, &t0, &t1) && (t1 - t0) > 0.0)
+            << "trial " << trial << ": a sight line misses the solid";
+      }
+      if (by_wall) {
+        // p and q strictly on opposite sides of the wall, crossing it between its ends.
+        const Line2 line = Line2::Through(wall.a, wall.b);
+        const double sp = line.SignedDistance(p), sq = line.SignedDistance(q);
+        ASSERT_LT(sp * sq, 0.0) << "trial " << trial;
+        const Eigen::Vector2d x = p + sp / (sp - sq) * (q - p);
+        const double along = (x - wall.a).dot(wall.b - wall.a) / (wall.b - wall.a).squaredNorm();
+        ASSERT_TRUE(along >= 0.0 && along <= 1.0) << "trial " << trial << ": misses the wall";
+      }
+    }
+  }
+  EXPECT_GT(hidden_by_solid, 100);  // the configurations do exercise both outcomes
+  EXPECT_LT(hidden_by_solid, 2900);
+  EXPECT_GT(hidden_by_wall, 10);
+}
+
+TEST(PlanVisibility, BearingRangeHoldsEverySampledBearingAndIsTight) {
+  std::mt19937 rng(9u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Ring2 region = RandomBox({0.0, 0.0}, 0.5, &rng);
+    const double a = 2.0 * kPi * unit(rng);
+    const Eigen::Vector2d f0 = (1.5 + 3.0 * unit(rng)) * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const Ring2 footprint = {f0,
+                             f0 + Eigen::Vector2d(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0)};
+    const BearingRange range = BearingsToFootprint(region, footprint);
+    if (range.all) continue;
+    EXPECT_GT(range.min, -kPi);
+    EXPECT_LE(range.min, kPi);
+    EXPECT_LT(range.max - range.min, kPi);
+    double widest = 0.0;
+    for (int k = 0; k < 300; ++k) {
+      const Eigen::Vector2d v =
+          footprint[0] + unit(rng) * (footprint[1] - footprint[0]) - PointIn(region, &rng);
+      const double b = std::atan2(v.y(), v.x());
+      const double from_min = b - range.min - 2.0 * kPi * std::floor((b - range.min) / (2.0 * kPi));
+      EXPECT_LE(from_min, range.max - range.min + kTol) << "trial " << trial;
+      widest = std::max(widest, from_min);
+    }
+    EXPECT_GT(widest, 0.8 * (range.max - range.min));  // not needlessly wide
+  }
+  // A footprint touching the region is seen under every bearing.
+  EXPECT_TRUE(BearingsToFootprint(Box(0, 0, 1, 1), {{1.0, 0.5}, {2.0, 0.5}}).all);
+  EXPECT_TRUE(BearingsToFootprint(Box(0, 0, 1, 1), {{0.5, 0.5}}).all);
+}
+
+}  // namespace
+}  // namespace linetrack
