@@ -17,15 +17,21 @@ double SignedDistance(const Eigen::Vector3d& unit_line, const Eigen::Vector2d& q
   return unit_line.x() * q.x() + unit_line.y() * q.y() + unit_line.z();
 }
 
-// Keeps the part of `polygon` where |s(q)| <= half_width, s the signed distance to the unit line.
-void ClipBand(const Eigen::Vector3d& l, double half_width, ConvexPolygon* polygon) {
-  const Eigen::Vector2d n(l.x(), l.y());
-  polygon->ClipHalfPlane(-n, half_width - l.z());  // s <= w
-  polygon->ClipHalfPlane(n, half_width + l.z());   // s >= -w
-}
 
 Eigen::Vector2d Trig(double a) {
   return {std::cos(a), std::sin(a)};
+}
+
+// Appends a bin with `bin`'s headings to `out`, reusing the storage of a previous bin there.
+HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
+  out->bins.emplace_back();
+  HeadingBin& b = out->bins.back();
+  b.lo = bin.lo;
+  b.hi = bin.hi;
+  b.trig_lo = bin.trig_lo;
+  b.trig_mid = bin.trig_mid;
+  b.trig_hi = bin.trig_hi;
+  return b;
 }
 
 bool Overlaps(const HeadingBin& bin, const std::vector<HeadingInterval>& parts) {
@@ -35,48 +41,73 @@ bool Overlaps(const HeadingBin& bin, const std::vector<HeadingInterval>& parts) 
   return false;
 }
 
-void DropEmpty(FeasibleRegion* region) {
-  region->bins.erase(std::remove_if(region->bins.begin(), region->bins.end(),
-                                    [](const HeadingBin& b) { return b.positions.Empty(); }),
-                     region->bins.end());
-}
 
 }  // namespace
 
 ConvexPolygon ConvexPolygon::AroundDisk(const Eigen::Vector2d& centre, double radius, int sides) {
   ConvexPolygon polygon;
+  sides = std::clamp(sides, 3, kMaxVertices);
   const double r = std::max(radius, 1e-3) / std::cos(kPi / sides);
   for (int i = 0; i < sides; ++i) {
     const double a = 2.0 * kPi * i / sides;
-    polygon.vertices_.push_back(centre + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    polygon.Push(centre + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
   }
   return polygon;
 }
 
-void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
-  if (vertices_.empty()) return;
-  bool all_inside = true;
-  for (const Eigen::Vector2d& v : vertices_)
-    all_inside = all_inside && n.dot(v) + d >= 0.0;
-  if (all_inside) return;
-  // Built in a reused buffer, swapped in: no allocation once the buffers have grown.
-  thread_local std::vector<Eigen::Vector2d> out;
-  out.clear();
-  for (size_t i = 0; i < vertices_.size(); ++i) {
-    const Eigen::Vector2d& a = vertices_[i];
-    const Eigen::Vector2d& b = vertices_[(i + 1) % vertices_.size()];
-    const double fa = n.dot(a) + d, fb = n.dot(b) + d;
-    if (fa >= 0.0) out.push_back(a);
-    if ((fa >= 0.0) != (fb >= 0.0)) out.push_back(a + (fa / (fa - fb)) * (b - a));
+void ConvexPolygon::Push(const Eigen::Vector2d& v) {
+  if (count_ == kMaxVertices) {
+    // Out of room (many cuts that each add a vertex): replace by the bounding box, which
+    // contains the polygon, so the region stays conservative.
+    Eigen::Vector2d lo = vertices_[0], hi = vertices_[0];
+    for (int i = 1; i < count_; ++i) {
+      lo = lo.cwiseMin(vertices_[i]);
+      hi = hi.cwiseMax(vertices_[i]);
+    }
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+    vertices_[0] = lo;
+    vertices_[1] = {hi.x(), lo.y()};
+    vertices_[2] = hi;
+    vertices_[3] = {lo.x(), hi.y()};
+    count_ = 4;
+    return;
   }
-  vertices_.swap(out);
+  vertices_[count_++] = v;
+}
+
+void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
+  if (count_ == 0) return;
+  bool all_inside = true;
+  for (int i = 0; i < count_ && all_inside; ++i) all_inside = n.dot(vertices_[i]) + d >= 0.0;
+  if (all_inside) return;
+  const ConvexPolygon source = *this;
+  ClipFrom(source, n, d);
+}
+
+void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n, double d) {
+  count_ = 0;
+  const int m = source.count_;
+  for (int i = 0; i < m; ++i) {
+    const Eigen::Vector2d& a = source.vertices_[i];
+    const Eigen::Vector2d& b = source.vertices_[(i + 1) % m];
+    const double fa = n.dot(a) + d, fb = n.dot(b) + d;
+    if (fa >= 0.0) Push(a);
+    if ((fa >= 0.0) != (fb >= 0.0)) Push(a + (fa / (fa - fb)) * (b - a));
+  }
+}
+
+void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
+                             const Eigen::Vector2d& n2, double d2) {
+  ConvexPolygon half;
+  half.ClipFrom(source, n1, d1);
+  ClipFrom(half, n2, d2);
 }
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& v : vertices_)
-    sum += v;
-  return vertices_.empty() ? sum : Eigen::Vector2d(sum / static_cast<double>(vertices_.size()));
+  for (int i = 0; i < count_; ++i) sum += vertices_[i];
+  return count_ == 0 ? sum : Eigen::Vector2d(sum / static_cast<double>(count_));
 }
 
 FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
@@ -114,15 +145,13 @@ Pose3Dof FeasibleRegion::Representative() const {
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
-                    FeasibleRegion* region) {
-  if (region->Empty()) return false;
+                    const FeasibleRegion& in, FeasibleRegion* out) {
+  out->bins.clear();
+  if (in.Empty()) return false;
   const std::vector<HeadingInterval> parts =
-      DirectionIntervals(line, edge.dir, region->Heading(), sigmas);
-  for (HeadingBin& bin : region->bins) {
-    if (!Overlaps(bin, parts)) {
-      bin.positions = ConvexPolygon();
-      continue;
-    }
+      DirectionIntervals(line, edge.dir, in.Heading(), sigmas);
+  for (const HeadingBin& bin : in.bins) {
+    if (!Overlaps(bin, parts)) continue;
     const Eigen::Vector2d centre = bin.positions.Centroid();
     const Eigen::Vector3d p =
         ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
@@ -132,21 +161,25 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
     // The line moves within the bin: its offset is affine in the position, so the polygon's
     // vertices bound the change.
     double slack = 0.0;
-    for (const Eigen::Vector2d& q : bin.positions.vertices()) {
+    for (const Eigen::Vector2d& q : bin.positions) {
       const double s = SignedDistance(mid, q);
       slack = std::max(
           {slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
     }
-    const double band =
-        PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas);
-    ClipBand(mid, band + slack, &bin.positions);
+    const double half_width =
+        PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas) + slack;
+    // |s(q)| <= half_width: two half-planes of the unit line.
+    const Eigen::Vector2d n(mid.x(), mid.y());
+    HeadingBin& cut = Append(bin, out);
+    cut.positions.ClipFrom(bin.positions, -n, half_width - mid.z(), n, half_width + mid.z());
+    if (cut.positions.Empty()) out->bins.pop_back();
   }
-  DropEmpty(region);
-  return !region->Empty();
+  return !out->Empty();
 }
 
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
-                 FeasibleRegion* region) {
+                 const FeasibleRegion& in, FeasibleRegion* out) {
+  out->bins.clear();
   const double margin = sigmas * line.bearing_sigma;
   // Camera directions from the foot: (h - w) + pi for h in the bin, widened by the margin:
   // from bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
@@ -155,15 +188,52 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
   auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
     return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
   };
-  for (HeadingBin& bin : region->bins) {
-    if (bin.hi - bin.lo + 2.0 * margin >= kPi) continue;
+  // Quick reject: the directions from the foot to the region's bounding box must meet the
+  // camera directions the headings allow.
+  if (!in.Empty() && in.Heading().Width() + 2.0 * margin < kPi) {
+    Eigen::Vector2d lo = *in.bins.front().positions.begin(), hi = lo;
+    for (const HeadingBin& bin : in.bins) {
+      for (const Eigen::Vector2d& q : bin.positions) {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    }
+    const Eigen::Vector2d centre = 0.5 * (lo + hi);
+    const double reach = 0.5 * (hi - lo).norm();
+    const Eigen::Vector2d to_box = centre - edge.foot;
+    const double distance = to_box.norm();
+    if (distance > reach) {
+      const double spread = std::asin(reach / distance);
+      const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
+      const double offset =
+          std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
+      if (offset > spread + 0.5 * in.Heading().Width() + margin) return false;
+    }
+  }
+  for (const HeadingBin& bin : in.bins) {
+    HeadingBin& cut = Append(bin, out);
+    if (bin.hi - bin.lo + 2.0 * margin >= kPi) {
+      cut.positions = bin.positions;
+      continue;
+    }
     const Eigen::Vector2d u1 = rotate(bin.trig_lo, a), u2 = rotate(bin.trig_hi, b);
     const Eigen::Vector2d n1(-u1.y(), u1.x()), n2(u2.y(), -u2.x());
-    bin.positions.ClipHalfPlane(n1, -n1.dot(edge.foot));
-    bin.positions.ClipHalfPlane(n2, -n2.dot(edge.foot));
+    cut.positions.ClipFrom(bin.positions, n1, -n1.dot(edge.foot), n2, -n2.dot(edge.foot));
+    if (cut.positions.Empty()) out->bins.pop_back();
   }
-  DropEmpty(region);
-  return !region->Empty();
+  return !out->Empty();
+}
+
+bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                    FeasibleRegion* region) {
+  const FeasibleRegion in = *region;
+  return AddNonVertical(line, edge, height, sigmas, in, region);
+}
+
+bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                 FeasibleRegion* region) {
+  const FeasibleRegion in = *region;
+  return AddVertical(line, edge, sigmas, in, region);
 }
 
 }  // namespace linetrack

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "matching/constraints.h"
@@ -15,21 +16,33 @@
 
 namespace linetrack {
 
-// Convex polygon in the floor plane (counter-clockwise).
+// Convex polygon in the floor plane (counter-clockwise), stored inline (no allocation: the
+// tree copies and cuts thousands of them per localisation).
 class ConvexPolygon {
  public:
+  static constexpr int kMaxVertices = 32;
+
   ConvexPolygon() = default;
   // Regular polygon circumscribing the disk (contains it).
   static ConvexPolygon AroundDisk(const Eigen::Vector2d& centre, double radius, int sides = 12);
 
   // Keeps the part where n . p + d >= 0.
   void ClipHalfPlane(const Eigen::Vector2d& n, double d);
-  bool Empty() const { return vertices_.size() < 3; }
+  // Sets this polygon to the part of `source` where n . p + d >= 0.
+  void ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n, double d);
+  // The same with two half-planes (a band or a wedge).
+  void ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
+                const Eigen::Vector2d& n2, double d2);
+  bool Empty() const { return count_ < 3; }
   Eigen::Vector2d Centroid() const;  // mean of the vertices
-  const std::vector<Eigen::Vector2d>& vertices() const { return vertices_; }
+  int size() const { return count_; }
+  const Eigen::Vector2d* begin() const { return vertices_.data(); }
+  const Eigen::Vector2d* end() const { return vertices_.data() + count_; }
 
  private:
-  std::vector<Eigen::Vector2d> vertices_;
+  void Push(const Eigen::Vector2d& v);
+  std::array<Eigen::Vector2d, kMaxVertices> vertices_;
+  int count_ = 0;
 };
 
 // Positions possible for headings in [lo, hi]; (cos, sin) of lo, mid and hi cached.
@@ -63,10 +76,15 @@ struct FeasibleRegion {
 // the line moves within the bin. Returns false when nothing is left.
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     FeasibleRegion* region);
+// The same, writing the cut of `in` into `out` (no copy of the bins that do not survive).
+bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                    const FeasibleRegion& in, FeasibleRegion* out);
 
 // Cuts `region` with a vertical correspondence: each bin's polygon is clipped to the wedge of
 // rays from the foot for the bin's headings (widened by the bearing noise).
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  FeasibleRegion* region);
+bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                 const FeasibleRegion& in, FeasibleRegion* out);
 
 }  // namespace linetrack

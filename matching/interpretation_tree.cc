@@ -82,12 +82,12 @@ class TreeSearch {
     });
   }
 
-  // Adds (edge, line) to a copy of `region`; false when the pose set becomes empty or a binary
+  // Writes `in` cut by (edge, line) into `out`; false when the pose set becomes empty or a binary
   // vertical constraint with an assigned vertical correspondence fails.
-  bool Extend(int edge, int line, FeasibleRegion* region) const {
+  bool Extend(int edge, int line, const FeasibleRegion& in, FeasibleRegion* out) const {
     const MatchEdge& e = edges_[edge];
     const ObservedLine& l = lines_[line];
-    if (!e.vertical) return AddNonVertical(l, e, prior_.height, options_.gate_sigmas, region);
+    if (!e.vertical) return AddNonVertical(l, e, prior_.height, options_.gate_sigmas, in, out);
     // The paper's binary constraint (inscribed-angle arc meets the prior disk, left-to-right
     // order) first: cheap; then the joint cut of the binned region, which subsumes it.
     for (const auto& [other_edge, other_line] : assigned_) {
@@ -97,7 +97,7 @@ class TreeSearch {
         return false;
       }
     }
-    return AddVertical(l, e, options_.gate_sigmas, region);
+    return AddVertical(l, e, options_.gate_sigmas, in, out);
   }
 
   void Search(size_t depth, const FeasibleRegion& region) {
@@ -119,12 +119,15 @@ class TreeSearch {
     }
     const Level& level = levels_[depth];
     const bool vertical = edges_[level.edge].vertical;
-    for (int line : level.lines) {
+    const HeadingInterval headings = region.Heading();
+    for (size_t c = 0; c < level.lines.size(); ++c) {
+      const int line = level.lines[c];
       if (used_[line] || (vertical && VerticalsFull())) continue;
+      // Cheap test first: the candidate's unary heading interval must meet the region's.
+      if (level.headings[c].lo > headings.hi || level.headings[c].hi < headings.lo) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
       FeasibleRegion& next = regions_[depth + 1];
-      next = region;
-      if (!Extend(level.edge, line, &next)) continue;
+      if (!Extend(level.edge, line, region, &next)) continue;
       next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
@@ -198,8 +201,7 @@ class TreeSearch {
       if (edges_[level.edge].vertical && VerticalsFull()) continue;
       for (int line : level.lines) {
         if (used_[line]) continue;
-        maximal_scratch_ = region;
-        if (Extend(level.edge, line, &maximal_scratch_)) return false;
+        if (Extend(level.edge, line, region, &maximal_scratch_)) return false;
       }
     }
     return true;
