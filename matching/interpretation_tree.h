@@ -17,7 +17,7 @@ namespace linetrack {
 struct InterpretationTreeOptions {
   double gate_sigmas = 3.0;      // noise margins of every constraint, in standard deviations
   double extent_slack_px = 8.0;  // tolerance of the extent constraints at segment endpoints
-  double heading_bin_deg = 0.5;  // finest heading bins of the feasible region (degrees)
+  double heading_bin_deg = 0.75;  // finest heading bins of the feasible region (degrees)
   int max_bins = 96;             // bins are split finer as the headings narrow, up to this
   int min_matches = 4;           // k: leaves with fewer correspondences are discarded
   int max_vertical_matches = 0;  // vertical correspondences per hypothesis (0: no limit)
