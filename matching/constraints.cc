@@ -228,14 +228,17 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
   const double sigmas = gate.sigmas;
   std::vector<HeadingInterval> out;
   for (const HeadingInterval& j : DirectionIntervals(line, edge.dir, prior, sigmas)) {
-    // Signed distance of the disk centre to the position line at three headings of the
-    // interval: a sign change means a crossing; else the smallest distance must be within the
-    // disk radius plus the noise band.
+    // Signed distance of the disk centre to the position line at headings across the interval:
+    // a sign change means a crossing; else the smallest distance must be within the disk radius
+    // plus the noise band.
     double smallest = std::numeric_limits<double>::infinity();
     double band = 0.0;
     int sign = 0;
     bool crosses = false;
-    for (double h : {j.lo, j.Mid(), j.hi}) {
+    // Samples at most 1 degree apart: the line's offset is not monotonic over wide intervals.
+    const int steps = std::max(2, static_cast<int>(std::ceil(j.Width() / DegToRad(1.0))));
+    for (int k = 0; k <= steps; ++k) {
+      const double h = j.lo + j.Width() * k / steps;
       const Eigen::Vector3d p = ObservedPointOnEdge(line, edge, height, h, centre);
       const Eigen::Vector3d l = PositionLine(line.normal, p, height, h);
       const double s = (l.x() * centre.x() + l.y() * centre.y() + l.z()) / std::hypot(l.x(), l.y());
@@ -246,15 +249,19 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
       band = std::max(band, PositionBandHalfWidth(line, p, height, h, centre, sigmas));
     }
     // The extent is checked at the exact root of the direction constraint when the interval
-    // holds one (the interval may be clipped by the prior, so its middle can be off).
-    double h_extent = j.Mid();
+    // holds one (the interval may be clipped by the prior, so its middle can be off), and at
+    // the interval's ends: with noise the heading is only known within the interval.
+    double h_root = j.Mid();
     for (double root : DirectionRoots(line.normal, edge.dir)) {
       const double shifted = root + 2.0 * kPi * std::round((j.Mid() - root) / (2.0 * kPi));
-      if (shifted >= j.lo && shifted <= j.hi) h_extent = shifted;
+      if (shifted >= j.lo && shifted <= j.hi) h_root = shifted;
     }
-    if ((crosses || smallest <= radius + band) &&
-        ExtentFeasible(line, edge, height, h_extent, centre, radius, band, gate.extent_slack_px,
-                       gate.focal_px)) {
+    bool extent = false;
+    for (double h : {h_root, j.lo, j.hi}) {
+      extent = extent || ExtentFeasible(line, edge, height, h, centre, radius, band,
+                                        gate.extent_slack_px, gate.focal_px);
+    }
+    if ((crosses || smallest <= radius + band) && extent) {
       out.push_back(j);
     }
   }

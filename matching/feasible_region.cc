@@ -17,7 +17,6 @@ double SignedDistance(const Eigen::Vector3d& unit_line, const Eigen::Vector2d& q
   return unit_line.x() * q.x() + unit_line.y() * q.y() + unit_line.z();
 }
 
-
 Eigen::Vector2d Trig(double a) {
   return {std::cos(a), std::sin(a)};
 }
@@ -40,7 +39,6 @@ bool Overlaps(const HeadingBin& bin, const std::vector<HeadingInterval>& parts) 
   }
   return false;
 }
-
 
 }  // namespace
 
@@ -79,7 +77,8 @@ void ConvexPolygon::Push(const Eigen::Vector2d& v) {
 void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
   if (count_ == 0) return;
   bool all_inside = true;
-  for (int i = 0; i < count_ && all_inside; ++i) all_inside = n.dot(vertices_[i]) + d >= 0.0;
+  for (int i = 0; i < count_ && all_inside; ++i)
+    all_inside = n.dot(vertices_[i]) + d >= 0.0;
   if (all_inside) return;
   const ConvexPolygon source = *this;
   ClipFrom(source, n, d);
@@ -106,7 +105,8 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  for (int i = 0; i < count_; ++i) sum += vertices_[i];
+  for (int i = 0; i < count_; ++i)
+    sum += vertices_[i];
   return count_ == 0 ? sum : Eigen::Vector2d(sum / static_cast<double>(count_));
 }
 
@@ -205,8 +205,7 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
     if (distance > reach) {
       const double spread = std::asin(reach / distance);
       const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
-      const double offset =
-          std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
+      const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
       if (offset > spread + 0.5 * in.Heading().Width() + margin) return false;
     }
   }

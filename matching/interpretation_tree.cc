@@ -219,7 +219,7 @@ class TreeSearch {
   std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
   mutable std::vector<bool> reachable_lines_;  // scratch of Reachable()
-  std::vector<FeasibleRegion> regions_;  // per depth
+  std::vector<FeasibleRegion> regions_;        // per depth
   mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
   int assigned_verticals_ = 0;

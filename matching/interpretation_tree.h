@@ -15,15 +15,16 @@
 namespace linetrack {
 
 struct InterpretationTreeOptions {
-  double gate_sigmas = 3.0;      // noise margins of every constraint, in standard deviations
-  double extent_slack_px = 8.0;  // tolerance of the extent constraints at segment endpoints
-  double heading_bin_deg = 0.75;  // finest heading bins of the feasible region (degrees)
-  int max_bins = 96;             // bins are split finer as the headings narrow, up to this
-  int min_matches = 4;           // k: leaves with fewer correspondences are discarded
-  int max_vertical_matches = 0;  // vertical correspondences per hypothesis (0: no limit)
-  int bound_slack = 2;           // branch and bound: leaves smaller than best - slack are pruned
-  int max_nodes = 200000;        // search budget (deterministic)
-  int max_hypotheses = 1000;     // leaves kept at most
+  double gate_sigmas = 3.0;           // noise margins of every constraint, in standard deviations
+  double vertical_gate_sigmas = 3.5;  // margin of the "can be a vertical edge" test of lines
+  double extent_slack_px = 8.0;       // tolerance of the extent constraints at segment endpoints
+  double heading_bin_deg = 0.75;      // finest heading bins of the feasible region (degrees)
+  int max_bins = 96;                  // bins are split finer as the headings narrow, up to this
+  int min_matches = 4;                // k: leaves with fewer correspondences are discarded
+  int max_vertical_matches = 0;       // vertical correspondences per hypothesis (0: no limit)
+  int bound_slack = 2;        // branch and bound: leaves smaller than best - slack are pruned
+  int max_nodes = 200000;     // search budget (deterministic)
+  int max_hypotheses = 1000;  // leaves kept at most
 
   bool Check(std::string* why) const;
 };

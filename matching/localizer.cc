@@ -76,8 +76,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   const std::vector<int> ids = CandidateEdges(problem);
   result.candidate_edges = static_cast<int>(ids.size());
   const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
-  const std::vector<ObservedLine> lines =
-      PrepareLines(problem.lines, camera_, problem.tilt, options_.noise, options_.tree.gate_sigmas);
+  const std::vector<ObservedLine> lines = PrepareLines(
+      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
 
   PriorRegion prior;
   prior.centre = {problem.prior.x, problem.prior.y};

@@ -91,3 +91,60 @@ TEST_F(ConstraintsTest, UnaryAndBinaryAcceptTheTruthAtAnyPriorInsideTheBounds) {
 
 }  // namespace
 }  // namespace linetrack
+
+namespace linetrack {
+namespace {
+
+// With the paper's noise the true correspondences pass the unary constraints at the 3-sigma
+// margins (nearly always), and most false pairings are cut.
+constexpr double kMinTruePass = 0.995;  // measured 0.998 with this seed
+constexpr double kMaxFalsePass = 0.20;  // measured 0.125: a regression to "accept all" fails
+
+TEST_F(ConstraintsTest, NoisyTruthPassesAndFalsePairingsAreCut) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double delta_t = 0.75, delta_phi = DegToRad(20.0);
+  int true_pass = 0, true_total = 0, false_pass = 0, false_total = 0;
+  for (int v = 0; v < kViews; ++v) {
+    const testing::ExactView view = hall_.RandomView(rng);
+    std::vector<Segment2> noisy;
+    for (const ProjectedEdge& p : view.pieces) {
+      noisy.push_back(testing::NoisySegment(p.image, 3.0, 1.0, 0.15, rng));
+    }
+    const std::vector<ObservedLine> lines =
+        PrepareLines(noisy, hall_.camera(), view.pose.tilt, LineNoise(), kSigmas);
+    Eigen::Vector2d offset;
+    do
+      offset = {unit(rng), unit(rng)};
+    while (offset.norm() > 1.0);
+    const Eigen::Vector2d centre = Eigen::Vector2d(view.pose.x, view.pose.y) + delta_t * offset;
+    const double heading = view.pose.heading + delta_phi * unit(rng);
+    const HeadingInterval prior{heading - delta_phi, heading + delta_phi};
+    for (size_t i = 0; i < lines.size(); ++i) {
+      for (size_t j = 0; j < view.pieces.size(); ++j) {
+        const MatchEdge edge = PrepareEdges(hall_.model(), {view.pieces[j].edge_id}).front();
+        const bool pass = edge.vertical ? lines[i].maybe_vertical &&
+                                              UnaryVertical(lines[i], edge, view.pose.height, prior,
+                                                            centre, delta_t, Gate())
+                                                  .has_value()
+                                        : !UnaryNonVertical(lines[i], edge, view.pose.height, prior,
+                                                            centre, delta_t, Gate())
+                                               .empty();
+        const bool truth = view.pieces[i].edge_id == edge.edge_id;
+        (truth ? true_pass : false_pass) += pass ? 1 : 0;
+        (truth ? true_total : false_total) += 1;
+      }
+    }
+  }
+  const double true_rate = static_cast<double>(true_pass) / true_total;
+  const double false_rate = static_cast<double>(false_pass) / false_total;
+  RecordProperty("true_pass_rate", std::to_string(true_rate));
+  RecordProperty("false_pass_rate", std::to_string(false_rate));
+  EXPECT_GE(true_rate, kMinTruePass);
+  EXPECT_LE(false_rate, kMaxFalsePass);
+  std::printf("unary constraints: true pass %.4f (%d), false pass %.4f (%d)\n", true_rate,
+              true_total, false_rate, false_total);
+}
+
+}  // namespace
+}  // namespace linetrack

@@ -67,4 +67,22 @@ class HallFixture {
   CameraIntrinsics camera_;
 };
 
+// The paper's line noise (Table 1): the segment rotated about its midpoint by N(0, angle) and
+// shifted along its normal by N(0, offset); the ends shortened by up to `shorten` each.
+inline Segment2 NoisySegment(const Segment2& s, double offset_px, double angle_deg, double shorten,
+                             std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector2d mid = s.Mid();
+  const double length = s.Length();
+  const double angle = DegToRad(angle_deg) * normal(rng);
+  const Eigen::Vector2d d = (s.b - s.a) / length;
+  const Eigen::Vector2d dir(std::cos(angle) * d.x() - std::sin(angle) * d.y(),
+                            std::sin(angle) * d.x() + std::cos(angle) * d.y());
+  const Eigen::Vector2d shift = offset_px * normal(rng) * Eigen::Vector2d(-dir.y(), dir.x());
+  const double t0 = -0.5 * length + shorten * length * unit(rng);
+  const double t1 = 0.5 * length - shorten * length * unit(rng);
+  return {mid + shift + t0 * dir, mid + shift + t1 * dir};
+}
+
 }  // namespace linetrack::testing
