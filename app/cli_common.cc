@@ -59,6 +59,15 @@ void WriteFileAtomically(const std::string& path, const std::string& content) {
   }
 }
 
+CLI::App* BenchGroup(CLI::App& cli) {
+  const auto found = cli.get_subcommands([](CLI::App* s) { return s->get_name() == "bench"; });
+  if (!found.empty()) return found.front();
+  CLI::App* bench = cli.add_subcommand(
+      "bench", "Benchmarks: accuracy and speed figures on this machine (see docs/)");
+  bench->require_subcommand(1);
+  return bench;
+}
+
 void EnsureDirectory(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -29,6 +29,9 @@ void CheckRange(double value, double lo, double hi, const std::string& flag);
 // sees a partial file. Throws InputError when the file cannot be written.
 void WriteFileAtomically(const std::string& path, const std::string& content);
 
+// The `bench` command group shared by the benchmarks (created by the first caller).
+CLI::App* BenchGroup(CLI::App& cli);
+
 // Creates `dir` (and parents) when missing; throws InputError when it cannot.
 void EnsureDirectory(const std::string& dir);
 

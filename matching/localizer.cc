@@ -86,8 +86,9 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
                    problem.prior.heading + problem.delta_phi};
   prior.height = problem.height;
   prior.focal_px = 0.5 * (camera_.px + camera_.py);
-  VerificationContext context{&edges,       &lines,      &camera_, problem.height,
-                              problem.tilt, &occlusion_, &prior,   area_};
+  VerificationContext context{&edges,         &lines,       &camera_,
+                              problem.height, problem.tilt, &occlusion_,
+                              &prior,         area_,        options_.noise.focal_relative};
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
     // Leaves are verified as the search finds them: the pose of the leaf's correspondences

@@ -112,17 +112,30 @@ void DropContestedClaims(const std::vector<std::optional<Segment2>>& projected,
   pairs->resize(kept);
 }
 
+// Extra distance (pixels, 3 sigma) a calibration error may put between a line and its edge's
+// projection: 3 focal_relative r, r the farthest endpoint's distance from the principal point.
+double CalibrationAllowance(const VerificationContext& context, const Segment2& s) {
+  const Eigen::Vector2d centre(context.camera->u0, context.camera->v0);
+  return 3.0 * context.focal_relative * std::max((s.a - centre).norm(), (s.b - centre).norm());
+}
+
 // Matched edges, distances (eq. 9, eq. 10) and plausibility of the pairs at the pose.
 void Score(const VerificationContext& context, const VerificationOptions& options,
            VerifiedPose* result) {
   const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result->pose);
   std::vector<double> distances;
   std::set<int> edges;
+  double relative = 0.0, allowance = 0.0;  // sums of d / threshold and of the allowances
   for (const auto& [e, l] : result->pairs) {
     edges.insert(e);
-    distances.push_back(projected[e] ? SegmentDistance(*projected[e], (*context.lines)[l].pixels)
+    const Segment2& line = (*context.lines)[l].pixels;
+    const double a = CalibrationAllowance(context, line);
+    distances.push_back(projected[e] ? SegmentDistance(*projected[e], line)
                                      : std::numeric_limits<double>::infinity());
+    relative += distances.back() / std::hypot(options.match_distance_px, a);
+    allowance += a;
   }
+  const double n = std::max<double>(1.0, distances.size());
   result->matched_edges = static_cast<int>(edges.size());
   double sum = 0.0;
   for (double d : distances)
@@ -132,11 +145,11 @@ void Score(const VerificationContext& context, const VerificationOptions& option
   result->score_px =
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->plausible =
-      result->mean_distance_px <= options.match_distance_px &&
-      InsidePrior(context, result->pose, options) && result->matched_edges >= options.min_matches &&
-      r.rms_px <= options.max_rms_px && r.position_sigma_m <= options.max_position_sigma_m &&
-      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  result->plausible = relative / n <= 1.0 && InsidePrior(context, result->pose, options) &&
+                      result->matched_edges >= options.min_matches &&
+                      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
+                      r.position_sigma_m <= options.max_position_sigma_m &&
+                      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 
 }  // namespace
@@ -159,9 +172,11 @@ std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& contex
   const Eigen::Vector3d eye(pose.x, pose.y, context.height);
   std::vector<std::pair<int, int>> guided, rivals;
   std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
-  const double rival_distance = options.rival_factor * options.match_distance_px;
   for (size_t l = 0; l < context.lines->size(); ++l) {
     const Segment2& observed = (*context.lines)[l].pixels;
+    const double match_distance =
+        std::hypot(options.match_distance_px, CalibrationAllowance(context, observed));
+    const double rival_distance = options.rival_factor * match_distance;
     near.clear();
     for (size_t e = 0; e < projected.size(); ++e) {
       if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
@@ -179,7 +194,7 @@ std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& contex
         continue;
       }
       rivals.emplace_back(e, static_cast<int>(l));
-      if (visible++ == 0 && d < options.match_distance_px) claimed = e;
+      if (visible++ == 0 && d < match_distance) claimed = e;
     }
     if (claimed >= 0 && visible == 1) guided.emplace_back(claimed, static_cast<int>(l));
   }
@@ -241,7 +256,6 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
   // exp(-d^2 / 2 sigma^2): evidence depends on the pose only, not on which lines were kept as
   // correspondences, and a close fit counts more than a loose one.
   const double max_angle = DegToRad(options.support_angle_deg);
-  const double sigma2 = options.evidence_sigma_px * options.evidence_sigma_px;
   const size_t num_lines = context.lines->size();
   std::vector<double> weight_of_line(num_lines, 0.0);
   PoseEvidence evidence;
@@ -254,8 +268,10 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
       const Segment2& s = (*context.lines)[l].pixels;
       if (AngleBetween(p.image, s) > max_angle) continue;
       const double d = SegmentDistance(p.image, s);
-      if (d > options.support_distance_px) continue;
-      const double w = std::exp(-0.5 * d * d / sigma2);
+      const double allowance = CalibrationAllowance(context, s);
+      if (d > std::hypot(options.support_distance_px, allowance)) continue;
+      const double sigma = std::hypot(options.evidence_sigma_px, allowance / 3.0);
+      const double w = std::exp(-0.5 * d * d / (sigma * sigma));
       weight_of_line[l] = std::max(weight_of_line[l], w);
       double t0 = (s.a - p.image.a).dot(axis), t1 = (s.b - p.image.a).dot(axis);
       if (t0 > t1) std::swap(t0, t1);

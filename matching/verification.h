@@ -65,6 +65,10 @@ struct VerificationContext {
   // inside the navigable area.
   const PriorRegion* prior = nullptr;
   const NavigableArea* area = nullptr;
+  // Relative focal-length uncertainty (LineNoise::focal_relative): a calibration error moves a
+  // line by up to focal_relative x its distance from the principal point, so the distance
+  // thresholds grow with that distance.
+  double focal_relative = 0.0;
 };
 
 // A verified hypothesis.

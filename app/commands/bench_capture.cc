@@ -85,15 +85,6 @@ int RunBenchCapture(BenchCaptureOptions opt) {
   return kExitOk;
 }
 
-// The `bench` group, shared with other benchmarks: found when another command made it first.
-CLI::App* BenchGroup(CLI::App& cli) {
-  const auto found = cli.get_subcommands([](CLI::App* s) { return s->get_name() == "bench"; });
-  if (!found.empty()) return found.front();
-  CLI::App* bench = cli.add_subcommand("bench", "Benchmarks: speed figures on this machine");
-  bench->require_subcommand(1);
-  return bench;
-}
-
 }  // namespace
 
 void AddBenchCapture(CLI::App& cli, CommandAction* action) {
