@@ -48,6 +48,11 @@ Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* re
       camera_(camera.Undistorted()),
       options_(options),
       occlusion_(model) {
+  // The focal scale is estimated with the pose, with the calibration error as its prior.
+  if (options_.verification.refinement.focal_prior_sigma == 0.0) {
+    options_.verification.refinement.focal_prior_sigma = options_.noise.focal_relative;
+    options_.verification.refinement.prior_pixel_sigma = std::max(options_.noise.offset_px, 0.5);
+  }
   std::string why;
   if (!options_.Check(&why)) throw InputError("localizer options: " + why);
   if (!camera_.Check(&why)) throw InputError("camera: " + why);

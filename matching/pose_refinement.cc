@@ -57,59 +57,113 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
   return r;
 }
 
+namespace {
+
+CameraIntrinsics Scaled(const CameraIntrinsics& camera, double scale) {
+  CameraIntrinsics c = camera;
+  c.px *= scale;
+  c.py *= scale;
+  return c;
+}
+
+}  // namespace
+
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options) {
+  return RefinePose(matches, camera, height, tilt, start, 1.0, options);
+}
+
+PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
+                                const CameraIntrinsics& camera, double height, double tilt,
+                                const Pose3Dof& start, double start_scale,
+                                const PoseRefinementOptions& options) {
   PoseRefinementResult result;
   result.pose = start;
+  result.focal_scale = start_scale;
   if (matches.empty()) return result;
   const int n = static_cast<int>(matches.size());
+  // Parameters: (heading, x, y) and, with enough lines and a prior, the focal scale s, which
+  // absorbs a calibration error (MAP with s ~ N(1, focal_prior_sigma), the prior weighed as one
+  // residual of prior_pixel_sigma pixels).
+  const bool with_scale = options.focal_prior_sigma > 0.0 && n >= options.min_matches_for_scale;
+  const int dof = with_scale ? 4 : 3;
+  const double prior_weight =
+      with_scale ? options.prior_pixel_sigma / options.focal_prior_sigma : 0.0;
+  auto huber = [&](double r) {
+    const double a = std::abs(r);
+    return options.huber_px > 0.0 && a > options.huber_px
+               ? options.huber_px * (2.0 * a - options.huber_px)
+               : a * a;
+  };
   auto weight = [&](double r) {
     const double a = std::abs(r);
     return options.huber_px > 0.0 && a > options.huber_px ? options.huber_px / a : 1.0;
   };
-  auto cost_at = [&](const Pose3Dof& pose) {
+  auto cost_at = [&](const Pose3Dof& pose, double scale) {
+    const CameraIntrinsics c = Scaled(camera, scale);
     double cost = 0.0;
     for (const LineMatch& m : matches) {
-      const Eigen::Vector2d r = EndpointResiduals(m, camera, height, tilt, pose);
+      const Eigen::Vector2d r = EndpointResiduals(m, c, height, tilt, pose);
+      cost += huber(r[0]) + huber(r[1]);
+    }
+    const double p = prior_weight * (scale - 1.0);
+    return cost + p * p;
+  };
+  // Normal equations at (pose, scale); the scale column by central differences.
+  auto normal_equations = [&](const Pose3Dof& pose, double scale, bool robust, Eigen::Matrix4d* jtj,
+                              Eigen::Vector4d* jtr) {
+    jtj->setZero();
+    jtr->setZero();
+    const CameraIntrinsics c = Scaled(camera, scale);
+    const double h = 1e-6;
+    const CameraIntrinsics up = Scaled(camera, scale + h), down = Scaled(camera, scale - h);
+    double squares = 0.0;
+    for (const LineMatch& m : matches) {
+      Eigen::Matrix<double, 2, 3> j3;
+      const Eigen::Vector2d r = EndpointResiduals(m, c, height, tilt, pose, &j3);
+      squares += r.squaredNorm();
+      Eigen::Matrix<double, 2, 4> j = Eigen::Matrix<double, 2, 4>::Zero();
+      j.leftCols<3>() = j3;
+      if (with_scale) {
+        j.col(3) = (EndpointResiduals(m, up, height, tilt, pose) -
+                    EndpointResiduals(m, down, height, tilt, pose)) /
+                   (2.0 * h);
+      }
       for (int k = 0; k < 2; ++k) {
-        const double a = std::abs(r[k]);
-        cost += options.huber_px > 0.0 && a > options.huber_px
-                    ? options.huber_px * (2.0 * a - options.huber_px)
-                    : a * a;
+        const double w = robust ? weight(r[k]) : 1.0;
+        *jtj += w * j.row(k).transpose() * j.row(k);
+        *jtr += w * j.row(k).transpose() * r[k];
       }
     }
-    return cost;
+    if (with_scale) {
+      (*jtj)(3, 3) += prior_weight * prior_weight;
+      (*jtr)(3) += prior_weight * prior_weight * (scale - 1.0);
+    }
+    return squares;
   };
 
   double lambda = 1e-3;
-  double cost = cost_at(result.pose);
-  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  double cost = cost_at(result.pose, result.focal_scale);
+  Eigen::Matrix4d jtj;
+  Eigen::Vector4d jtr;
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
-    jtj.setZero();
-    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
-    for (const LineMatch& m : matches) {
-      Eigen::Matrix<double, 2, 3> j;
-      const Eigen::Vector2d r = EndpointResiduals(m, camera, height, tilt, result.pose, &j);
-      for (int k = 0; k < 2; ++k) {
-        const double w = weight(r[k]);
-        jtj += w * j.row(k).transpose() * j.row(k);
-        jtr += w * j.row(k).transpose() * r[k];
-      }
-    }
+    normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr);
     bool improved = false;
-    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    Eigen::Vector4d step = Eigen::Vector4d::Zero();
     for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
-      Eigen::Matrix3d damped = jtj;
+      Eigen::MatrixXd damped = jtj.topLeftCorner(dof, dof);
       damped.diagonal() *= 1.0 + lambda;
       damped.diagonal().array() += 1e-12;
-      step = -damped.ldlt().solve(jtr);
+      step.head(dof) = -damped.ldlt().solve(jtr.head(dof));
       const Pose3Dof trial{result.pose.x + step[1], result.pose.y + step[2],
                            result.pose.heading + step[0]};
-      const double trial_cost = cost_at(trial);
-      if (std::isfinite(trial_cost) && trial_cost <= cost) {
+      const double trial_scale = result.focal_scale + step[3];
+      const double trial_cost = cost_at(trial, trial_scale);
+      if (std::isfinite(trial_cost) && trial_cost <= cost && trial_scale > 0.5) {
         result.pose = trial;
+        result.focal_scale = trial_scale;
         cost = trial_cost;
         lambda = std::max(lambda * 0.3, 1e-9);
         improved = true;
@@ -123,22 +177,18 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     }
   }
   result.pose.heading = WrapAngle(result.pose.heading);
-  double squares = 0.0;
-  jtj.setZero();
-  for (const LineMatch& m : matches) {
-    Eigen::Matrix<double, 2, 3> j;
-    squares += EndpointResiduals(m, camera, height, tilt, result.pose, &j).squaredNorm();
-    jtj += j.transpose() * j;
-  }
+  const double squares = normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr);
   result.rms_px = std::sqrt(squares / (2.0 * n));
-  const Eigen::LDLT<Eigen::Matrix3d> information(jtj);
-  const Eigen::Matrix3d covariance = information.solve(Eigen::Matrix3d::Identity());
-  if (information.info() == Eigen::Success && covariance.allFinite() && covariance(0, 0) >= 0.0) {
+  // Pose uncertainty for 1 pixel of noise (the scale, when estimated, is marginalised out).
+  const Eigen::MatrixXd information = jtj.topLeftCorner(dof, dof);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(information);
+  const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(dof, dof));
+  if (ldlt.info() == Eigen::Success && covariance.allFinite() && covariance(0, 0) >= 0.0) {
     result.heading_sigma_rad = std::sqrt(covariance(0, 0));
-    result.position_sigma_m =
-        std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
-                                    covariance.block<2, 2>(1, 1), Eigen::EigenvaluesOnly)
-                                    .eigenvalues()[1]));
+    const Eigen::Matrix2d position = covariance.block<2, 2>(1, 1);
+    result.position_sigma_m = std::sqrt(std::max(
+        0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position, Eigen::EigenvaluesOnly)
+                 .eigenvalues()[1]));
   } else {
     result.heading_sigma_rad = result.position_sigma_m = std::numeric_limits<double>::infinity();
   }

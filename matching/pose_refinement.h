@@ -25,13 +25,20 @@ struct PoseRefinementOptions {
   int max_iterations = 15;
   double step_tolerance = 1e-7;  // stop when the update (rad, m) is below this
   double huber_px = 3.0;         // Huber threshold on endpoint residuals (pixels); 0: plain LS
+  // Focal scale s (px, py times s) estimated with the pose when > 0: the prior std of s - 1
+  // (LineNoise::focal_relative), weighed like one residual of prior_pixel_sigma pixels; only with
+  // at least min_matches_for_scale correspondences.
+  double focal_prior_sigma = 0.0;
+  double prior_pixel_sigma = 3.0;
+  int min_matches_for_scale = 5;
 
   bool Check(std::string* why) const;
 };
 
 struct PoseRefinementResult {
   Pose3Dof pose;
-  double rms_px = 0.0;  // RMS endpoint residual at the end
+  double focal_scale = 1.0;  // estimated scale of px, py (1 when not estimated)
+  double rms_px = 0.0;       // RMS endpoint residual at the end
   int iterations = 0;
   bool converged = false;
   // Standard deviations of the pose for 1 pixel of endpoint noise, from (J^T J)^-1: large
@@ -46,9 +53,14 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   double height, double tilt, const Pose3Dof& pose,
                                   Eigen::Matrix<double, 2, 3>* jacobian = nullptr);
 
-// Refines `start` by Levenberg-Marquardt on all endpoint residuals (Huber-weighted).
+// Refines `start` by Levenberg-Marquardt on all endpoint residuals (Huber-weighted), with the
+// focal scale too when the options ask for it (starting from `start_scale`).
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options);
+PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
+                                const CameraIntrinsics& camera, double height, double tilt,
+                                const Pose3Dof& start, double start_scale,
+                                const PoseRefinementOptions& options);
 
 }  // namespace linetrack

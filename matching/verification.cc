@@ -33,21 +33,30 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
   return matches;
 }
 
+// The camera with its focal lengths scaled by `scale` (the estimated calibration error).
+CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
+  CameraIntrinsics c = camera;
+  c.px *= scale;
+  c.py *= scale;
+  return c;
+}
+
 // Projects every candidate edge at `pose` (frustum-clipped, no occlusion); empty segments for
 // edges out of view.
 std::vector<std::optional<Segment2>> ProjectEdges(const VerificationContext& context,
-                                                  const Pose3Dof& pose) {
+                                                  const Pose3Dof& pose, double focal_scale) {
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   std::vector<std::optional<Segment2>> out;
   out.reserve(context.edges->size());
   for (const MatchEdge& edge : *context.edges) {
     Segment3 s{edge.a, edge.b};
-    if (!ClipToFrustum(cam_from_world, *context.camera, 0.05, &s)) {
+    if (!ClipToFrustum(cam_from_world, camera, 0.05, &s)) {
       out.emplace_back();
       continue;
     }
-    out.push_back(Segment2{context.camera->Project(cam_from_world * s.a),
-                           context.camera->Project(cam_from_world * s.b)});
+    out.push_back(
+        Segment2{camera.Project(cam_from_world * s.a), camera.Project(cam_from_world * s.b)});
   }
   return out;
 }
@@ -122,7 +131,8 @@ double CalibrationAllowance(const VerificationContext& context, const Segment2& 
 // Matched edges, distances (eq. 9, eq. 10) and plausibility of the pairs at the pose.
 void Score(const VerificationContext& context, const VerificationOptions& options,
            VerifiedPose* result) {
-  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, result->pose);
+  const std::vector<std::optional<Segment2>> projected =
+      ProjectEdges(context, result->pose, result->refinement.focal_scale);
   std::vector<double> distances;
   std::set<int> edges;
   double relative = 0.0, allowance = 0.0;  // sums of d / threshold and of the allowances
@@ -145,11 +155,12 @@ void Score(const VerificationContext& context, const VerificationOptions& option
   result->score_px =
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->plausible = relative / n <= 1.0 && InsidePrior(context, result->pose, options) &&
-                      result->matched_edges >= options.min_matches &&
-                      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
-                      r.position_sigma_m <= options.max_position_sigma_m &&
-                      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  result->plausible =
+      relative / n <= 1.0 && result->mean_distance_px <= options.max_mean_distance_px &&
+      InsidePrior(context, result->pose, options) && result->matched_edges >= options.min_matches &&
+      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
+      r.position_sigma_m <= options.max_position_sigma_m &&
+      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 
 }  // namespace
@@ -164,9 +175,10 @@ bool VerificationOptions::Check(std::string* why) const {
 }
 
 std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
-                                               const Pose3Dof& pose,
+                                               const Pose3Dof& pose, double focal_scale,
                                                const VerificationOptions& options) {
-  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, pose);
+  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, pose, focal_scale);
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const double max_angle = DegToRad(options.match_angle_deg);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   const Eigen::Vector3d eye(pose.x, pose.y, context.height);
@@ -189,8 +201,8 @@ std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& contex
     int claimed = -1, visible = 0;
     for (const auto& [d, e] : near) {
       if (context.occlusion != nullptr &&
-          context.occlusion->Blocked(eye, PointSeenOnEdge((*context.edges)[e], observed,
-                                                          cam_from_world, eye, *context.camera))) {
+          context.occlusion->Blocked(
+              eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
         continue;
       }
       rivals.emplace_back(e, static_cast<int>(l));
@@ -207,10 +219,12 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
   VerifiedPose result = start;
   for (int round = 0; round < options.guided_rounds; ++round) {
     if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
-    std::vector<std::pair<int, int>> guided = GuidedMatches(context, result.pose, options);
+    std::vector<std::pair<int, int>> guided =
+        GuidedMatches(context, result.pose, result.refinement.focal_scale, options);
     if (guided.size() < 2) break;
-    result.refinement = RefinePose(ToLineMatches(context, guided), *context.camera, context.height,
-                                   context.tilt, result.pose, options.refinement);
+    result.refinement =
+        RefinePose(ToLineMatches(context, guided), *context.camera, context.height, context.tilt,
+                   result.pose, result.refinement.focal_scale, options.refinement);
     result.pairs = std::move(guided);
     result.pose = result.refinement.pose;
   }
@@ -248,7 +262,8 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
   projection.sample_step_px = 6.0;
   projection.min_length_px = 2.0;
   const std::vector<ProjectedEdge> pieces = ProjectVisibleEdges(
-      model, occlusion, CamFromWorld(Full(verified.pose, context)), *context.camera, projection);
+      model, occlusion, CamFromWorld(Full(verified.pose, context)),
+      ScaledCamera(*context.camera, verified.refinement.focal_scale), projection);
   std::map<int, double> visible_length;
   for (const ProjectedEdge& p : pieces)
     visible_length[p.edge_id] += p.image.Length();

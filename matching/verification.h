@@ -23,8 +23,9 @@ struct VerificationOptions {
   double overlap_px = 5.0;         // lines of one edge overlapping more than this: all dropped
   double rival_factor = 1.5;       // lines within this x match_distance_px compete for an edge
 
-  double max_rms_px = 6.5;  // endpoint RMS of an acceptable pose
-  int min_matches = 4;      // distinct model edges matched in an accepted pose
+  double max_mean_distance_px = 3.5;  // mean eq. 9 distance of an acceptable pose's pairs
+  double max_rms_px = 6.5;            // endpoint RMS of an acceptable pose
+  int min_matches = 4;                // distinct model edges matched in an accepted pose
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
   double min_support = 0.7;
@@ -94,11 +95,12 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options);
 
-// Matches every line to the nearest candidate edge projected at `pose` (eq. 9 distance and
+// Matches every line to the nearest candidate edge projected at `pose` (focal lengths scaled by
+// `focal_scale`) (eq. 9 distance and
 // angle under the options' thresholds), skipping edges hidden where the line lies; lines of one
 // edge that overlap along it are all dropped. Returns (edge index, line index) pairs.
 std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
-                                               const Pose3Dof& pose,
+                                               const Pose3Dof& pose, double focal_scale,
                                                const VerificationOptions& options);
 
 // Re-matches and re-estimates from `start` (options.guided_rounds rounds), then scores.
