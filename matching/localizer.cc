@@ -216,7 +216,7 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
   result.score_px = best.score_px;
-  for (const auto& [e, l] : best.pairs)
+  for (const auto& [e, l] : best.confident_pairs)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());
 }

@@ -91,14 +91,22 @@ Eigen::Vector3d PointSeenOnEdge(const MatchEdge& edge, const Segment2& observed,
   return edge.a + t * d;
 }
 
+// A line near an edge: (edge index, line index) and its eq. 9 distance (pixels).
+struct Claim {
+  int edge = -1;
+  int line = -1;
+  double distance = 0.0;
+};
+
 // Two lines near the same edge over the same stretch cannot both be its image (fragments of one
-// edge do not overlap): one of them is clutter and the distance cannot tell which reliably, so
-// a claim is dropped when another line within the looser `rivals` window overlaps it along the
-// edge. A wrong correspondence is worse than a missing one. `rivals` are (edge, line) pairs.
-void DropContestedClaims(const std::vector<std::optional<Segment2>>& projected,
-                         const std::vector<ObservedLine>& lines, double overlap_px,
-                         const std::vector<std::pair<int, int>>& rivals,
-                         std::vector<std::pair<int, int>>* pairs) {
+// edge do not overlap). A claim with no such rival is confident; with rivals that all fit much
+// worse (distance over twice its own plus a pixel) it is the clear winner, good enough for the
+// pose but not reported (the clutter may be the better fit); otherwise it is dropped. A wrong
+// correspondence is worse than a missing one. `rivals` are all lines near visible edges.
+void SortClaims(const std::vector<std::optional<Segment2>>& projected,
+                const std::vector<ObservedLine>& lines, double overlap_px,
+                const std::vector<Claim>& rivals, const std::vector<Claim>& claims,
+                GuidedMatching* out) {
   auto overlap = [&](int edge_index, int line_a, int line_b) {
     const Segment2& edge = *projected[edge_index];
     const Eigen::Vector2d axis = (edge.b - edge.a).normalized();
@@ -109,16 +117,20 @@ void DropContestedClaims(const std::vector<std::optional<Segment2>>& projected,
     const auto a = span(lines[line_a].pixels), b = span(lines[line_b].pixels);
     return std::min(a.second, b.second) - std::max(a.first, b.first);
   };
-  size_t kept = 0;
-  for (const std::pair<int, int>& claim : *pairs) {
-    bool contested = false;
-    for (const std::pair<int, int>& rival : rivals) {
-      contested = contested || (rival.first == claim.first && rival.second != claim.second &&
-                                overlap(claim.first, claim.second, rival.second) > overlap_px);
+  for (const Claim& claim : claims) {
+    bool rivalled = false, contested = false;
+    for (const Claim& rival : rivals) {
+      if (rival.edge != claim.edge || rival.line == claim.line ||
+          overlap(claim.edge, claim.line, rival.line) <= overlap_px) {
+        continue;
+      }
+      rivalled = true;
+      contested = contested || rival.distance <= 2.0 * claim.distance + 1.0;
     }
-    if (!contested) (*pairs)[kept++] = claim;
+    if (contested) continue;
+    out->for_pose.emplace_back(claim.edge, claim.line);
+    if (!rivalled) out->confident.emplace_back(claim.edge, claim.line);
   }
-  pairs->resize(kept);
 }
 
 // Extra distance (pixels, 3 sigma) a calibration error may put between a line and its edge's
@@ -174,15 +186,14 @@ bool VerificationOptions::Check(std::string* why) const {
   return refinement.Check(why);
 }
 
-std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
-                                               const Pose3Dof& pose, double focal_scale,
-                                               const VerificationOptions& options) {
+GuidedMatching GuidedMatches(const VerificationContext& context, const Pose3Dof& pose,
+                             double focal_scale, const VerificationOptions& options) {
   const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, pose, focal_scale);
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const double max_angle = DegToRad(options.match_angle_deg);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   const Eigen::Vector3d eye(pose.x, pose.y, context.height);
-  std::vector<std::pair<int, int>> guided, rivals;
+  std::vector<Claim> claims, rivals;
   std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
   for (size_t l = 0; l < context.lines->size(); ++l) {
     const Segment2& observed = (*context.lines)[l].pixels;
@@ -205,13 +216,15 @@ std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& contex
               eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
         continue;
       }
-      rivals.emplace_back(e, static_cast<int>(l));
+      rivals.push_back({e, static_cast<int>(l), d});
       if (visible++ == 0 && d < match_distance) claimed = e;
     }
-    if (claimed >= 0 && visible == 1) guided.emplace_back(claimed, static_cast<int>(l));
+    // Exactly one visible edge near the line, and near enough: it is the last rival pushed.
+    if (claimed >= 0 && visible == 1) claims.push_back(rivals.back());
   }
-  DropContestedClaims(projected, *context.lines, options.overlap_px, rivals, &guided);
-  return guided;
+  GuidedMatching matching;
+  SortClaims(projected, *context.lines, options.overlap_px, rivals, claims, &matching);
+  return matching;
 }
 
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
@@ -219,13 +232,14 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
   VerifiedPose result = start;
   for (int round = 0; round < options.guided_rounds; ++round) {
     if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
-    std::vector<std::pair<int, int>> guided =
+    GuidedMatching guided =
         GuidedMatches(context, result.pose, result.refinement.focal_scale, options);
-    if (guided.size() < 2) break;
+    if (guided.for_pose.size() < 2) break;
     result.refinement =
-        RefinePose(ToLineMatches(context, guided), *context.camera, context.height, context.tilt,
-                   result.pose, result.refinement.focal_scale, options.refinement);
-    result.pairs = std::move(guided);
+        RefinePose(ToLineMatches(context, guided.for_pose), *context.camera, context.height,
+                   context.tilt, result.pose, result.refinement.focal_scale, options.refinement);
+    result.pairs = std::move(guided.for_pose);
+    result.confident_pairs = std::move(guided.confident);
     result.pose = result.refinement.pose;
   }
   Score(context, options, &result);

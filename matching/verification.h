@@ -20,7 +20,7 @@ struct VerificationOptions {
   double match_distance_px = 6.0;  // eq. 9 distance below which a line matches an edge
   double match_angle_deg = 4.0;    // and angle between the line and the projected edge
   int guided_rounds = 2;           // re-matching + re-estimation rounds
-  double overlap_px = 5.0;         // lines of one edge overlapping more than this: all dropped
+  double overlap_px = 5.0;         // lines of one edge overlapping more than this are rivals
   double rival_factor = 1.5;       // lines within this x match_distance_px compete for an edge
 
   double max_mean_distance_px = 3.5;  // mean eq. 9 distance of an acceptable pose's pairs
@@ -76,9 +76,11 @@ struct VerificationContext {
 struct VerifiedPose {
   Pose3Dof pose;
   std::vector<std::pair<int, int>> pairs;  // (edge index, line index), after guided matching
-  int matched_edges = 0;                   // distinct edges in pairs
-  double mean_distance_px = 0.0;           // mean eq. 9 distance over the pairs
-  double score_px = 0.0;                   // eq. 10 partial Hausdorff distance (k = min_matches)
+  // The pairs no other line contests: the correspondences reported.
+  std::vector<std::pair<int, int>> confident_pairs;
+  int matched_edges = 0;          // distinct edges in pairs
+  double mean_distance_px = 0.0;  // mean eq. 9 distance over the pairs
+  double score_px = 0.0;          // eq. 10 partial Hausdorff distance (k = min_matches)
   PoseRefinementResult refinement;
   bool plausible = false;  // passed the RMS and observability checks
 };
@@ -95,13 +97,19 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
                               const VerificationOptions& options);
 
+// Guided matching at a pose: `for_pose` are the pairs the pose is estimated from, `confident`
+// those of them no other line contests (the correspondences reported).
+struct GuidedMatching {
+  std::vector<std::pair<int, int>> for_pose;
+  std::vector<std::pair<int, int>> confident;
+};
+
 // Matches every line to the nearest candidate edge projected at `pose` (focal lengths scaled by
 // `focal_scale`) (eq. 9 distance and
 // angle under the options' thresholds), skipping edges hidden where the line lies; lines of one
 // edge that overlap along it are all dropped. Returns (edge index, line index) pairs.
-std::vector<std::pair<int, int>> GuidedMatches(const VerificationContext& context,
-                                               const Pose3Dof& pose, double focal_scale,
-                                               const VerificationOptions& options);
+GuidedMatching GuidedMatches(const VerificationContext& context, const Pose3Dof& pose,
+                             double focal_scale, const VerificationOptions& options);
 
 // Re-matches and re-estimates from `start` (options.guided_rounds rounds), then scores.
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
