@@ -212,6 +212,13 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     result.reason = "low support " + std::to_string(result.support);
     return;
   }
+  std::set<int> confident_edges;
+  for (const auto& pair : best.confident_pairs) confident_edges.insert(pair.first);
+  if (static_cast<int>(confident_edges.size()) < vo.min_confident_edges) {
+    result.reason = "too few uncontested correspondences (" +
+                    std::to_string(confident_edges.size()) + ")";
+    return;
+  }
   result.found = true;
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);

@@ -147,14 +147,15 @@ void Score(const VerificationContext& context, const VerificationOptions& option
       ProjectEdges(context, result->pose, result->refinement.focal_scale);
   std::vector<double> distances;
   std::set<int> edges;
-  double relative = 0.0, allowance = 0.0;  // sums of d / threshold and of the allowances
+  // Sums of d / max(mean distance, calibration allowance) and of the allowances.
+  double relative = 0.0, allowance = 0.0;
   for (const auto& [e, l] : result->pairs) {
     edges.insert(e);
     const Segment2& line = (*context.lines)[l].pixels;
     const double a = CalibrationAllowance(context, line);
     distances.push_back(projected[e] ? SegmentDistance(*projected[e], line)
                                      : std::numeric_limits<double>::infinity());
-    relative += distances.back() / std::hypot(options.match_distance_px, a);
+    relative += distances.back() / std::hypot(options.max_mean_distance_px, a);
     allowance += a;
   }
   const double n = std::max<double>(1.0, distances.size());
@@ -168,10 +169,11 @@ void Score(const VerificationContext& context, const VerificationOptions& option
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
   result->plausible =
-      relative / n <= 1.0 && result->mean_distance_px <= options.max_mean_distance_px &&
+      relative / n <= 1.0 &&
       InsidePrior(context, result->pose, options) && result->matched_edges >= options.min_matches &&
       r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
       r.position_sigma_m <= options.max_position_sigma_m &&
+      std::abs(r.focal_scale - 1.0) <= 3.0 * options.refinement.focal_prior_sigma &&
       r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 

@@ -25,7 +25,8 @@ struct VerificationOptions {
 
   double max_mean_distance_px = 3.5;  // mean eq. 9 distance of an acceptable pose's pairs
   double max_rms_px = 6.5;            // endpoint RMS of an acceptable pose
-  int min_matches = 4;                // distinct model edges matched in an accepted pose
+  int min_matches = 4;          // distinct model edges matched in an accepted pose
+  int min_confident_edges = 3;  // uncontested correspondences an accepted pose must report
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
   double min_support = 0.7;
