@@ -64,7 +64,7 @@ std::vector<VerifiedPose> SampleAndVerify(const VerificationContext& context,
         continue;
       }
       ++stats->poses;
-      verified.push_back(VerifyHypothesis(context, {{e1, l1}, {e2, l2}}, pose, verification));
+      verified.push_back(VerifyHypothesis(context, {{e1, l1}, {e2, l2}}, {pose}, verification));
       const VerifiedPose& v = verified.back();
       if (v.plausible && v.matched_edges > best_matches) {
         // Adaptive stop: with m true correspondences among E x L, a drawn pair is all-true

@@ -138,10 +138,19 @@ void FeasibleRegion::Refine(int max_bins, double min_width) {
   }
 }
 
-Pose3Dof FeasibleRegion::Representative() const {
-  const HeadingBin& bin = bins[bins.size() / 2];
-  const Eigen::Vector2d c = bin.positions.Centroid();
-  return {c.x(), c.y(), 0.5 * (bin.lo + bin.hi)};
+std::vector<Pose3Dof> FeasibleRegion::Representatives() const {
+  std::vector<Pose3Dof> poses;
+  size_t first = 0;
+  for (size_t i = 1; i <= bins.size(); ++i) {
+    const bool run_ends =
+        i == bins.size() || bins[i].lo - bins[i - 1].hi > 0.5 * (bins[i].hi - bins[i].lo);
+    if (!run_ends) continue;
+    const HeadingBin& bin = bins[(first + i - 1) / 2];
+    const Eigen::Vector2d c = bin.positions.Centroid();
+    poses.push_back({c.x(), c.y(), 0.5 * (bin.lo + bin.hi)});
+    first = i;
+  }
+  return poses;
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,

@@ -62,8 +62,9 @@ struct FeasibleRegion {
   bool Empty() const { return bins.empty(); }
   // Hull of the surviving headings.
   HeadingInterval Heading() const { return {bins.front().lo, bins.back().hi}; }
-  // A representative pose: the middle surviving bin's heading and polygon centroid.
-  Pose3Dof Representative() const;
+  // Representative poses: for each run of contiguous surviving bins, the middle bin's heading
+  // and polygon centroid (the runs are the separate pose clusters the correspondences allow).
+  std::vector<Pose3Dof> Representatives() const;
 
   // Splits bins in halves (each keeps its polygon) while there are at most `max_bins / 2` and
   // they are wider than `min_width` radians: coarse bins while the heading is wide, fine ones

@@ -193,15 +193,39 @@ class TreeSearch {
     return std::min(levels + vertical_levels, lines);
   }
 
-  // A leaf is kept only when no skipped edge could have been matched as well: every subset of a
-  // consistent assignment is consistent, and verifying those again would be wasted work.
+  // True when the extension keeps most of the region (at least half of its heading bins and a
+  // bin of each run of contiguous bins): the leaf then adds nothing to it. An extension consistent
+  // with only a part of the region (another pose cluster) does not make the leaf redundant.
+  static bool KeepsEveryCluster(const FeasibleRegion& region, const FeasibleRegion& extended) {
+    if (2 * extended.bins.size() < region.bins.size()) return false;
+    size_t first = 0;
+    for (size_t i = 1; i <= region.bins.size(); ++i) {
+      const bool run_ends =
+          i == region.bins.size() ||
+          region.bins[i].lo - region.bins[i - 1].hi > 0.5 * (region.bins[i].hi - region.bins[i].lo);
+      if (!run_ends) continue;
+      const double lo = region.bins[first].lo, hi = region.bins[i - 1].hi;
+      const bool kept = std::any_of(extended.bins.begin(), extended.bins.end(),
+                                    [&](const HeadingBin& b) { return b.hi > lo && b.lo < hi; });
+      if (!kept) return false;
+      first = i;
+    }
+    return true;
+  }
+
+  // A leaf is kept only when no skipped edge could have been matched as well in every pose
+  // cluster: every subset of a consistent assignment is consistent, and verifying those again
+  // would be wasted work.
   bool IsMaximal(const FeasibleRegion& region) const {
     for (int depth : skipped_) {
       const Level& level = levels_[depth];
       if (edges_[level.edge].vertical && VerticalsFull()) continue;
       for (int line : level.lines) {
         if (used_[line]) continue;
-        if (Extend(level.edge, line, region, &maximal_scratch_)) return false;
+        if (Extend(level.edge, line, region, &maximal_scratch_) &&
+            KeepsEveryCluster(region, maximal_scratch_)) {
+          return false;
+        }
       }
     }
     return true;

@@ -109,7 +109,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
         edges, lines, prior, options_.tree,
         [&](const Hypothesis& h) {
           ++result.hypotheses;
-          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representative(), vo);
+          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
           for (const Pose3Dof& seen : leaf_poses) {
             if (std::hypot(seen.x - leaf.pose.x, seen.y - leaf.pose.y) < vo.duplicate_distance_m &&
                 std::abs(WrapAngle(seen.heading - leaf.pose.heading)) <
@@ -213,10 +213,11 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     return;
   }
   std::set<int> confident_edges;
-  for (const auto& pair : best.confident_pairs) confident_edges.insert(pair.first);
+  for (const auto& pair : best.confident_pairs)
+    confident_edges.insert(pair.first);
   if (static_cast<int>(confident_edges.size()) < vo.min_confident_edges) {
-    result.reason = "too few uncontested correspondences (" +
-                    std::to_string(confident_edges.size()) + ")";
+    result.reason =
+        "too few uncontested correspondences (" + std::to_string(confident_edges.size()) + ")";
     return;
   }
   result.found = true;

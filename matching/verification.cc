@@ -168,13 +168,12 @@ void Score(const VerificationContext& context, const VerificationOptions& option
   result->score_px =
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->plausible =
-      relative / n <= 1.0 &&
-      InsidePrior(context, result->pose, options) && result->matched_edges >= options.min_matches &&
-      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
-      r.position_sigma_m <= options.max_position_sigma_m &&
-      std::abs(r.focal_scale - 1.0) <= 3.0 * options.refinement.focal_prior_sigma &&
-      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  result->plausible = relative / n <= 1.0 && InsidePrior(context, result->pose, options) &&
+                      result->matched_edges >= options.min_matches &&
+                      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
+                      r.position_sigma_m <= options.max_position_sigma_m &&
+                      std::abs(r.focal_scale - 1.0) <= 3.0 * options.refinement.focal_prior_sigma &&
+                      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
 }
 
 }  // namespace
@@ -249,20 +248,28 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
 }
 
 VerifiedPose RefineHypothesis(const VerificationContext& context,
-                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const std::vector<std::pair<int, int>>& pairs,
+                              const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options) {
   VerifiedPose result;
   result.pairs = pairs;
-  result.refinement = RefinePose(ToLineMatches(context, pairs), *context.camera, context.height,
-                                 context.tilt, start, options.refinement);
+  const std::vector<LineMatch> matches = ToLineMatches(context, pairs);
+  for (const Pose3Dof& start : starts) {
+    const PoseRefinementResult r = RefinePose(matches, *context.camera, context.height,
+                                              context.tilt, start, options.refinement);
+    if (result.refinement.iterations == 0 || r.rms_px < result.refinement.rms_px) {
+      result.refinement = r;
+    }
+  }
   result.pose = result.refinement.pose;
   return result;
 }
 
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
-                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const std::vector<std::pair<int, int>>& pairs,
+                              const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options) {
-  return Rematch(context, RefineHypothesis(context, pairs, start, options), options);
+  return Rematch(context, RefineHypothesis(context, pairs, starts, options), options);
 }
 
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
@@ -316,7 +323,8 @@ PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& 
     evidence.fitted_px += std::min(piece_weighted, length);
   }
   for (size_t l = 0; l < num_lines; ++l) {
-    evidence.explained_px += weight_of_line[l] * (*context.lines)[l].pixels.Length();
+    evidence.explained_px +=
+        weight_of_line[l] * ((*context.lines)[l].pixels.Length() + options.line_bonus_px);
   }
   return evidence;
 }

@@ -25,15 +25,18 @@ struct VerificationOptions {
 
   double max_mean_distance_px = 3.5;  // mean eq. 9 distance of an acceptable pose's pairs
   double max_rms_px = 6.5;            // endpoint RMS of an acceptable pose
-  int min_matches = 4;          // distinct model edges matched in an accepted pose
-  int min_confident_edges = 3;  // uncontested correspondences an accepted pose must report
+  int min_matches = 4;                // distinct model edges matched in an accepted pose
+  int min_confident_edges = 3;        // uncontested correspondences an accepted pose must report
   // Share of the predicted visible model-edge length (edges projecting longer than
   // support_min_length_px, with occlusion) that observed lines cover.
   double min_support = 0.7;
   double support_min_length_px = 40.0;
   double support_distance_px = 10.0;  // a line within this (eq. 9) and angle confirms an edge
   double support_angle_deg = 6.0;
-  double evidence_sigma_px = 3.0;      // a supporting line weighs exp(-d^2 / 2 sigma^2)
+  double evidence_sigma_px = 3.0;  // a supporting line weighs exp(-d^2 / 2 sigma^2)
+  // An explained line counts its length plus this: a short line fitting an edge exactly is
+  // strong evidence too.
+  double line_bonus_px = 60.0;
   double max_position_sigma_m = 0.15;  // per pixel of noise (pose observability)
   double max_heading_sigma_deg = 1.5;  // per pixel of noise
   double prior_margin_m = 0.5;         // a pose may leave the prior disk by this much
@@ -86,16 +89,18 @@ struct VerifiedPose {
   bool plausible = false;  // passed the RMS and observability checks
 };
 
-// The pose of a hypothesis (pairs of edge/line indices) by Levenberg-Marquardt from `start`,
-// not yet re-matched nor scored.
+// The pose of a hypothesis (pairs of edge/line indices) by Levenberg-Marquardt from each of the
+// `starts`, the lowest residual kept; not yet re-matched nor scored.
 VerifiedPose RefineHypothesis(const VerificationContext& context,
-                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const std::vector<std::pair<int, int>>& pairs,
+                              const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options);
 
 // RefineHypothesis, then matches all candidate edges to lines at that pose and re-estimates
 // (guided rounds), and scores.
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
-                              const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                              const std::vector<std::pair<int, int>>& pairs,
+                              const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options);
 
 // Guided matching at a pose: `for_pose` are the pairs the pose is estimated from, `confident`
