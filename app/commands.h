@@ -10,5 +10,6 @@ void AddModelInfo(CLI::App& cli, CommandAction* action);
 void AddLocalize(CLI::App& cli, CommandAction* action);
 void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
+void AddSynth(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   app::AddLocalize(cli, &action);
   app::AddRender(cli, &action);
   app::AddBenchCapture(cli, &action);
+  app::AddSynth(cli, &action);
 
   try {
     cli.parse(argc, argv);
