@@ -11,5 +11,6 @@ void AddLocalize(CLI::App& cli, CommandAction* action);
 void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
+void AddSynth(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

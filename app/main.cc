@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   app::AddRender(cli, &action);
   app::AddBenchCapture(cli, &action);
   app::AddBenchMatch(cli, &action);
+  app::AddSynth(cli, &action);
 
   try {
     cli.parse(argc, argv);
