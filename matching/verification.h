@@ -45,8 +45,8 @@ struct VerificationOptions {
   // A different pose (farther than these) whose evidence score reaches ambiguity_ratio of the
   // best one's is an ambiguity: no answer. Only the `finalists` best hypotheses (by matched
   // edges) are scored with occlusion.
-  double ambiguity_distance_m = 0.3;
-  double ambiguity_heading_deg = 5.0;
+  double ambiguity_distance_m = 0.6;
+  double ambiguity_heading_deg = 6.0;
   double ambiguity_ratio = 0.8;
   // Leaves whose own pose lies this close to a leaf already verified are not verified again.
   double duplicate_distance_m = 0.05;
