@@ -6,11 +6,9 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
 scripts/setup.sh build
-scripts/fetch_test_data.sh build/testdata
 (cd build && ctest --output-on-failure -j "$jobs")
 
-scripts/setup.sh build-asan -DLINETRACK_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DLINETRACK_TEST_DATA="$PWD/build/testdata"
+scripts/setup.sh build-asan -DLINETRACK_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
 (cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --output-on-failure -j "$jobs")
 echo "test: all suites passed"
