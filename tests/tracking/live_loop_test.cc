@@ -17,6 +17,7 @@
 #include "tracking/head/head_pointing.h"
 #include "tracking/live/live_loop.h"
 #include "tracking/live/sim_camera.h"
+#include "tracking/live/sim_rig.h"
 
 namespace linetrack {
 namespace {
@@ -54,27 +55,6 @@ const NavigableArea& HallArea() {
   return area;
 }
 
-// The simulator, the truth estimator and the loop, wired as `linetrack live --source sim
-// --head sim` wires them.
-struct SimRig {
-  SimRig(const SimCameraOptions& camera_options, const SimulatedHeadOptions& head_options,
-         const LiveLoopOptions& loop_options, const PoseJitterOptions& jitter = {})
-      : head(head_options),
-        camera(Hall(), &HallArea(), PaperCamera(), camera_options),
-        truth(&camera, jitter) {
-    camera.AttachHead(&head);
-    LiveLoopOptions options = loop_options;
-    options.crossing_height = camera.crossing_height();
-    loop = std::make_unique<LiveLoop>(
-        &camera, &head, &truth, [this](double t) { return camera.OdometryAt(t); }, Hall(),
-        PaperCamera(), options);
-  }
-  SimulatedHead head;
-  SimulatedCamera camera;
-  SimulatorTruthEstimator truth;
-  std::unique_ptr<LiveLoop> loop;
-};
-
 SimCameraOptions StillBase(const Pose3Dof& base) {
   SimCameraOptions options;
   options.path = SimPath::kStill;
@@ -83,18 +63,14 @@ SimCameraOptions StillBase(const Pose3Dof& base) {
   return options;
 }
 
-// Head options that start `offset` (pan, tilt) away from the angles that centre `target`.
-SimulatedHeadOptions HeadOffsetFrom(const SimCameraOptions& camera, const Eigen::Vector3d& target,
-                                    double pan_offset, double tilt_offset) {
-  const HeadGeometry geometry = GeometryOf(camera.head_model);
-  const double crossing = CrossingHeightFor(geometry, camera.camera_height);
-  double pan = 0.0, tilt = 0.0;
-  EXPECT_TRUE(HeadAnglesLookingAt(geometry, WorldFromHeadBase(camera.still_base, crossing), target,
-                                  &pan, &tilt));
-  SimulatedHeadOptions head;
-  head.initial_pan = pan + pan_offset;
-  head.initial_tilt = tilt + tilt_offset;
-  return head;
+// The rig of `linetrack live --source sim --head sim` with the head starting `offset` (pan, tilt)
+// away from the angles that centre the target.
+std::unique_ptr<SimulatedLiveRig> Rig(const SimCameraOptions& camera, const LiveLoopOptions& loop,
+                                      double pan_offset, double tilt_offset) {
+  SimHeadStart start;
+  start.offset_from_target = Eigen::Vector2d(pan_offset, tilt_offset);
+  return std::make_unique<SimulatedLiveRig>(Hall(), &HallArea(), PaperCamera(), camera,
+                                            SimulatedHeadOptions{}, loop, start);
 }
 
 // Every frame: joints within their limits, head rates and commands within the maximum speeds.
@@ -111,20 +87,18 @@ const Eigen::Vector3d kPillarCorner(9.25, 2.75, 1.5);  // on the edge of the sec
 
 TEST(LiveLoop, ConvergesFromATenByFiveDegreeOffset) {
   const SimCameraOptions camera = StillBase({3.0, 1.5, DegToRad(20.0)});
-  const SimulatedHeadOptions head =
-      HeadOffsetFrom(camera, kPillarCorner, DegToRad(10.0), DegToRad(5.0));
   LiveLoopOptions options;
   options.target = kPillarCorner;
-  SimRig rig(camera, head, options);
+  auto rig = Rig(camera, options, DegToRad(10.0), DegToRad(5.0));
   LiveSummary summary;
   LiveIteration it;
   double start_error_px = 0.0;
   for (int k = 0; k < 150; ++k) {  // 5 s
-    it = rig.loop->Step();
+    it = rig->loop().Step();
     ASSERT_EQ(it.grab, FrameStatus::kOk);
     ASSERT_TRUE(it.estimate.has_pose());
     ASSERT_TRUE(it.servo.ok) << it.servo.reason;
-    ExpectWithinLimits(it, rig.head.Limits(), options.servo);
+    ExpectWithinLimits(it, rig->head().Limits(), options.servo);
     summary.Add(it);
     if (k == 0) start_error_px = it.servo.error_px;
   }
@@ -144,13 +118,13 @@ TEST(LiveLoop, ConvergesToAChosenPixel) {
   LiveLoopOptions options;
   options.target = kPillarCorner;
   options.desired_px = Eigen::Vector2d(200.0, 300.0);
-  SimRig rig(camera, HeadOffsetFrom(camera, kPillarCorner, 0.0, 0.0), options);
+  auto rig = Rig(camera, options, 0.0, 0.0);
   LiveIteration it;
   for (int k = 0; k < 150; ++k)
-    it = rig.loop->Step();
+    it = rig->loop().Step();
   ASSERT_TRUE(it.servo.ok);
   const Eigen::Vector2d seen =
-      PaperCamera().Project(rig.camera.last_cam_from_world() * kPillarCorner);
+      PaperCamera().Project(rig->camera().last_cam_from_world() * kPillarCorner);
   EXPECT_LT((seen - Eigen::Vector2d(200.0, 300.0)).norm(), kMaxFinalErrorPx);
 }
 
@@ -167,28 +141,17 @@ DriveErrors DriveOneLap(const HeadServoOptions& servo) {
   LiveLoopOptions options;
   options.servo = servo;
   options.target = target;
-  // Start pointing at the target from the loop's first pose.
-  SimRig probe(camera, SimulatedHeadOptions{}, options);
-  const Pose3Dof start = probe.camera.BaseAt(0.0);
-  double pan = 0.0, tilt = 0.0;
-  EXPECT_TRUE(HeadAnglesLookingAt(GeometryOf(camera.head_model),
-                                  WorldFromHeadBase(start, probe.camera.crossing_height()), target,
-                                  &pan, &tilt));
-  SimulatedHeadOptions head;
-  head.initial_pan = pan;
-  head.initial_tilt = tilt;
-  SimRig rig(camera, head, options);
+  auto rig = Rig(camera, options, 0.0, 0.0);  // pointing at the target from the first pose
   LiveSummary summary;
   DriveErrors errors;
   int settled = 0;
   for (int k = 0; k < 76 * 30; ++k) {  // one lap: about 38 m at 0.5 m/s, corners included
-    const LiveIteration it = rig.loop->Step();
+    const LiveIteration it = rig->loop().Step();
     EXPECT_TRUE(it.servo.ok) << it.servo.reason;
-    ExpectWithinLimits(it, rig.head.Limits(), options.servo);
+    ExpectWithinLimits(it, rig->head().Limits(), options.servo);
     summary.Add(it);
     if (it.t < kSettleS) continue;
-    const Eigen::Vector3d seen = rig.camera.last_cam_from_world() * target;
-    const double error_px = (PaperCamera().Project(seen) - rig.loop->desired_px()).norm();
+    const double error_px = rig->TrueErrorPx();
     errors.max_px = std::max(errors.max_px, error_px);
     errors.mean_px += error_px;
     ++settled;
@@ -217,13 +180,13 @@ TEST(LiveLoop, StopsTheHeadWhenThePoseIsLostAndResumesAfter) {
   camera.cap_to_s = 1.5;
   LiveLoopOptions options;
   options.target = kPillarCorner;
-  SimRig rig(camera, HeadOffsetFrom(camera, kPillarCorner, DegToRad(10.0), DegToRad(5.0)), options);
+  auto rig = Rig(camera, options, DegToRad(10.0), DegToRad(5.0));
   LiveSummary summary;
   int stops = 0;
   double capped_pan = std::nan("");
   LiveIteration it;
   for (int k = 0; k < 150; ++k) {
-    it = rig.loop->Step();
+    it = rig->loop().Step();
     summary.Add(it);
     const bool capped = it.t >= camera.cap_from_s && it.t < camera.cap_to_s;
     if (!capped) {
@@ -252,22 +215,23 @@ TEST(LiveLoop, StopsTheHeadWhenThePoseIsLostAndResumesAfter) {
 
 TEST(LiveLoop, TargetDefaultsToTheCentroidOfTheVisibleModel) {
   const SimCameraOptions camera = StillBase({3.0, 1.5, DegToRad(20.0)});
-  SimRig rig(camera, SimulatedHeadOptions{}, LiveLoopOptions{});
-  const LiveIteration first = rig.loop->Step();
+  SimulatedLiveRig rig(Hall(), &HallArea(), PaperCamera(), camera, SimulatedHeadOptions{},
+                       LiveLoopOptions{});
+  const LiveIteration first = rig.loop().Step();
   ASSERT_TRUE(first.has_target);
-  ASSERT_TRUE(rig.loop->target().has_value());
+  ASSERT_TRUE(rig.loop().target().has_value());
   // A convex combination of points inside the view frustum projects inside the image.
-  const Eigen::Vector3d seen = rig.camera.last_cam_from_world() * *rig.loop->target();
+  const Eigen::Vector3d seen = rig.camera().last_cam_from_world() * *rig.loop().target();
   EXPECT_GT(seen.z(), 0.0);
   EXPECT_TRUE(PaperCamera().Contains(PaperCamera().Project(seen)));
   const OcclusionTester occlusion(Hall());
   const auto again =
-      VisibleModelCentroid(Hall(), occlusion, rig.camera.last_cam_from_world(), PaperCamera());
+      VisibleModelCentroid(Hall(), occlusion, rig.camera().last_cam_from_world(), PaperCamera());
   ASSERT_TRUE(again.has_value());
-  EXPECT_TRUE(again->isApprox(*rig.loop->target(), 1e-12));
+  EXPECT_TRUE(again->isApprox(*rig.loop().target(), 1e-12));
   LiveIteration it;
   for (int k = 0; k < 90; ++k)
-    it = rig.loop->Step();
+    it = rig.loop().Step();
   EXPECT_TRUE(it.target.isApprox(first.target, 1e-12));  // fixed after the first pose
   EXPECT_LT(it.servo.error_px, kMaxFinalErrorPx);
 }
