@@ -11,24 +11,30 @@
 
 namespace linetrack::app {
 
-Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
+std::vector<double> ParseNumberList(const std::string& text, size_t count, const std::string& flag,
+                                    const std::string& form) {
   std::stringstream in(text);
   std::string field;
-  double values[3];
-  int n = 0;
+  std::vector<double> values;
   while (std::getline(in, field, ',')) {
-    if (n >= 3) throw InputError(flag + ": expected X,Y,HEADING_DEG, got '" + text + "'");
+    if (values.size() >= count)
+      throw InputError(flag + ": expected " + form + ", got '" + text + "'");
     try {
       size_t used = 0;
-      values[n] = std::stod(field, &used);
-      if (used != field.size() || !std::isfinite(values[n])) throw std::invalid_argument(field);
+      values.push_back(std::stod(field, &used));
+      if (used != field.size() || !std::isfinite(values.back())) throw std::invalid_argument(field);
     } catch (const std::exception&) {
       throw InputError(flag + ": not a finite number: '" + field + "' in '" + text + "'");
     }
-    ++n;
   }
-  if (n != 3) throw InputError(flag + ": expected X,Y,HEADING_DEG, got '" + text + "'");
-  return {values[0], values[1], DegToRad(values[2])};
+  if (values.size() != count)
+    throw InputError(flag + ": expected " + form + ", got '" + text + "'");
+  return values;
+}
+
+Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
+  const std::vector<double> v = ParseNumberList(text, 3, flag, "X,Y,HEADING_DEG");
+  return {v[0], v[1], DegToRad(v[2])};
 }
 
 void CheckRange(double value, double lo, double hi, const std::string& flag) {

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "models/robot_pose.h"
 
@@ -17,6 +18,11 @@ constexpr int kExitBadInput = 2;   // bad usage or bad input (one line on stderr
 
 // What a chosen subcommand runs after parsing; returns the exit code.
 using CommandAction = std::function<int()>;
+
+// Parses `count` comma-separated finite numbers ("1.5,2,-3"); `form` names them in errors
+// (e.g. "X,Y,Z"). Throws InputError naming `flag` when malformed.
+std::vector<double> ParseNumberList(const std::string& text, size_t count, const std::string& flag,
+                                    const std::string& form);
 
 // Parses "X,Y,HEADING_DEG" (metres, metres, degrees) into a Pose3Dof with heading in radians.
 // Throws InputError naming `flag` when malformed or not finite.

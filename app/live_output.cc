@@ -51,18 +51,18 @@ const char* const kLiveCsvHeader =
 
 std::string LiveCsvRow(const LiveIteration& it) {
   char numbers[512];
-  std::snprintf(numbers, sizeof(numbers),
-                "%lld,%.6f,%s,%s,%s,%.4f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.3f,%.3f,%.3f,%.4f,%d,%d,%d,%d,"
-                "%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,",
-                static_cast<long long>(it.frame), it.t, ToString(it.grab),
-                ToString(it.estimate.status), CsvField(it.estimate.source).c_str(),
-                RadToDeg(it.head.pan), RadToDeg(it.head.tilt), RadToDeg(it.head.pan_rate),
-                RadToDeg(it.head.tilt_rate), ToString(it.command), RadToDeg(it.servo.pan_rate),
-                RadToDeg(it.servo.tilt_rate), it.servo.error_u_px, it.servo.error_v_px,
-                it.servo.error_px, it.servo.gain, it.servo.converged, it.servo.saturated,
-                it.servo.limited, it.servo.compensated, it.camera_prior.x, it.camera_prior.y,
-                RadToDeg(it.camera_prior.heading), RadToDeg(it.camera_prior.tilt), it.estimate_ms,
-                it.loop_ms);
+  std::snprintf(
+      numbers, sizeof(numbers),
+      "%lld,%.6f,%s,%s,%s,%.4f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.3f,%.3f,%.3f,%.4f,%d,%d,%d,%d,"
+      "%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,",
+      static_cast<long long>(it.frame), it.t, ToString(it.grab), ToString(it.estimate.status),
+      CsvField(it.estimate.source).c_str(), RadToDeg(it.head.pan), RadToDeg(it.head.tilt),
+      RadToDeg(it.head.pan_rate), RadToDeg(it.head.tilt_rate), ToString(it.command),
+      RadToDeg(it.servo.pan_rate), RadToDeg(it.servo.tilt_rate), it.servo.error_u_px,
+      it.servo.error_v_px, it.servo.error_px, it.servo.gain, it.servo.converged, it.servo.saturated,
+      it.servo.limited, it.servo.compensated, it.camera_prior.x, it.camera_prior.y,
+      RadToDeg(it.camera_prior.heading), RadToDeg(it.camera_prior.tilt), it.estimate_ms,
+      it.loop_ms);
   std::string note = it.note;
   if (it.command != HeadCommand::kNone && !it.command_result.ok()) {
     note += (note.empty() ? "" : "; ") + std::string("head: ") + it.command_result.message;
