@@ -37,7 +37,8 @@ struct LiveCommandOptions {
   std::string head_model = "ptu46";
   std::string estimator = "auto";
   double height = -1.0;
-  double duration = -1.0;  // < 0: 10 s for the simulator, until stopped otherwise
+  double duration = 0.0;
+  bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
   int snapshot_every = 30;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
 };
@@ -128,7 +129,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   CheckRange(opt.max_rate_deg, 0.1, 360.0, "--max-rate");
   plan.loop.servo.model = plan.head_model;
   plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
-  plan.duration = opt.duration >= 0.0 ? opt.duration : (plan.sim ? 10.0 : 0.0);
+  plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
   CheckRange(plan.duration, 0.0, 1e7, "--duration");
   if (opt.estimator != "auto" && opt.estimator != "truth") {
     throw InputError("--estimator: expected auto or truth, got '" + opt.estimator + "'");
@@ -221,6 +222,7 @@ int RunLive(const LiveCommandOptions& opt) {
   const OcclusionTester occlusion(model);
   LiveSummary summary;
   std::string stop_reason = "duration";
+  HeadResult stopped;
   // Simulated time: the duration is a number of frames (0: until stopped).
   const std::int64_t max_frames = std::llround(plan.duration * plan.sim_camera.fps);
   {
@@ -236,6 +238,9 @@ int RunLive(const LiveCommandOptions& opt) {
         break;
       }
       summary.Add(it);
+      if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
+        spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
+      }
       const Eigen::Isometry3d truth = rig.camera().last_cam_from_world();
       output.Add(it, &truth);
       if (opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0) {
@@ -250,10 +255,11 @@ int RunLive(const LiveCommandOptions& opt) {
       }
       if (max_frames > 0 && summary.frames >= max_frames) break;
     }
-    const HeadResult stopped = loop.SafeStop();  // the head first, then the files
+    stopped = loop.SafeStop();  // the head first, then the files
     if (!stopped.ok()) spdlog::error("head: could not stop: {}", stopped.message);
   }
   nlohmann::ordered_json json = SummaryJson(summary, stop_reason);
+  json["head_stopped_at_end"] = stopped.ok();
   json["source"] = rig.camera().Describe();
   json["head"] = rig.head().Describe();
   json["estimator"] = rig.estimator().Describe();
@@ -309,7 +315,10 @@ void AddLive(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--estimator", opt->estimator,
                   "Camera pose: auto | truth (simulator's true pose, sim only)")
       ->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunLive(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    opt->duration_given = cmd->get_option("--duration")->count() > 0;
+    *action = [opt] { return RunLive(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

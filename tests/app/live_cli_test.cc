@@ -1,0 +1,242 @@
+// `linetrack live --source sim --head sim` end to end, headless: the outputs (head log, poses,
+// truth, snapshots, summary) are complete and consistent, the servo converges from a 10/5 degree
+// offset, bad input exits 2 with one line and writes nothing, and SIGINT stops the run cleanly.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "models/trajectory_io.h"
+
+extern char** environ;
+
+namespace linetrack {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kMaxFinalErrorPx = 2.0;
+constexpr int kCsvColumns = 27;
+
+const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kModel = kSource + "/models/hall.cao";
+const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
+
+std::string ReadAll(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    lines.push_back(line);
+  return lines;
+}
+
+// Fields of a CSV row (quoted fields may hold commas).
+std::vector<std::string> CsvFields(const std::string& row) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (char c : row) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+class LiveCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    out_ = dir_ / "run";
+  }
+
+  // Runs `linetrack live ARGS`; returns the exit code, stderr in *err.
+  int Live(const std::string& args, std::string* err) {
+    const fs::path err_path = dir_ / "stderr.txt";
+    const std::string cmd =
+        std::string(LINETRACK_EXE) + " live " + args + " > /dev/null 2> " + err_path.string();
+    const int status = std::system(cmd.c_str());
+    *err = ReadAll(err_path);
+    fs::remove(err_path);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  std::string StillSim() const {
+    return "--source sim --head sim --model " + kModel + " --camera " + kCamera +
+           " --prior 3,1.5,20 --height 1.3 --target 9.25,2.75,1.5 --out " + out_.string();
+  }
+
+  fs::path dir_, out_;
+};
+
+TEST_F(LiveCli, SimulatedRunWritesItsOutputsAndConverges) {
+  std::string err;
+  ASSERT_EQ(Live(StillSim() + " --head-start-offset 10,5 --duration 2 --snapshot-every 30", &err),
+            0)
+      << err;
+  const std::vector<std::string> rows = Lines(ReadAll(out_ / "frames.csv"));
+  ASSERT_EQ(rows.size(), 61u);  // header + 2 s at 30 frames/s
+  EXPECT_EQ(CsvFields(rows[0]).size(), static_cast<size_t>(kCsvColumns));
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> f = CsvFields(rows[k]);
+    ASSERT_EQ(f.size(), static_cast<size_t>(kCsvColumns)) << rows[k];
+    EXPECT_EQ(f[0], std::to_string(k - 1));
+    EXPECT_EQ(f[2], "ok");
+    EXPECT_EQ(f[3], "tracking");
+  }
+  const std::vector<std::string> first = CsvFields(rows[1]), last = CsvFields(rows.back());
+  EXPECT_GT(std::stod(first[14]), 150.0);  // 10 deg / 5 deg off at px = 1000
+  EXPECT_EQ(first[9], "velocity");
+  EXPECT_LT(std::stod(last[14]), kMaxFinalErrorPx);
+  EXPECT_EQ(last[16], "1");  // converged
+
+  const std::vector<StampedPose> poses = ParseTum(ReadAll(out_ / "poses.txt"), "poses.txt");
+  const std::vector<StampedPose> truth = ParseTum(ReadAll(out_ / "truth.txt"), "truth.txt");
+  ASSERT_EQ(poses.size(), 60u);
+  ASSERT_EQ(truth.size(), 60u);
+  EXPECT_TRUE(poses.back().world_from_cam.isApprox(truth.back().world_from_cam, 1e-6));
+
+  const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
+  EXPECT_EQ(summary["frames"], 60);
+  EXPECT_EQ(summary["frames_with_pose"], 60);
+  EXPECT_EQ(summary["stop_reason"], "duration");
+  EXPECT_EQ(summary["interrupted"], false);
+  EXPECT_EQ(summary["head_stopped_at_end"], true);
+  EXPECT_LT(summary["final_error_px"].get<double>(), kMaxFinalErrorPx);
+  EXPECT_GE(summary["first_convergence_s"].get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(out_ / "snapshots" / "frame_00000.png"));
+  EXPECT_TRUE(fs::exists(out_ / "snapshots" / "frame_00030.png"));
+  EXPECT_FALSE(fs::exists(out_ / "snapshots" / "frame_00015.png"));
+}
+
+TEST_F(LiveCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
+  const std::string common =
+      " --model " + kModel + " --camera " + kCamera + " --height 1.3 --out " + out_.string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--source sim --head ptu:/dev/ttyUSB0 --prior 3,1.5,20", "go together"},
+      {"--source sim:path=spiral --head sim --prior 3,1.5,20", "sim:path=spiral"},
+      {"--source sim --head biclops --prior 3,1.5,20", "--head biclops"},
+      {"--source sim --head sim --prior 3,1.5", "--prior"},
+      {"--source sim --head sim", "--prior"},
+      {"--source sim:path=loop --head sim --prior 3,1.5,20", "--prior"},
+      {"--source sim --head sim --prior 3,1.5,20 --target 1,2", "--target"},
+      {"--source sim --head sim --prior 3,1.5,20 --head-start-offset 10,5", "--head-start-offset"},
+      {"--source sim --head sim --prior 3,1.5,20 --head-start 500,0", "--head-start"},
+      {"--source sim --head sim --prior 3,1.5,20 --head-model scara", "--head-model"},
+      {"--source sim --head sim --prior 3,1.5,20 --duration -5", "--duration"},
+      {"--source aravis --head ptu:/dev/ttyUSB0 --prior 3,1.5,20", "tracker"},
+  };
+  for (const auto& [args, what] : cases) {
+    std::string err;
+    EXPECT_EQ(Live(args + common, &err), 2) << args;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;
+    EXPECT_NE(err.find(what), std::string::npos) << args << ": " << err;
+    EXPECT_FALSE(fs::exists(out_)) << args;
+  }
+  std::string err;
+  EXPECT_EQ(Live("--source sim --head sim --prior 3,1.5,20 --height 1.3 --model /nonexistent.cao "
+                 "--camera " +
+                     kCamera + " --out " + out_.string(),
+                 &err),
+            2);
+  EXPECT_NE(err.find("/nonexistent.cao"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out_));
+}
+
+// SIGINT in the middle of a long run: the head is stopped, the files are complete, and the
+// summary says the run was interrupted.
+TEST_F(LiveCli, SigintStopsTheHeadAndLeavesValidFiles) {
+  int pipe_fds[2];
+  ASSERT_EQ(pipe(pipe_fds), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  std::vector<std::string> args = {LINETRACK_EXE,
+                                   "live",
+                                   "--source",
+                                   "sim",
+                                   "--head",
+                                   "sim",
+                                   "--model",
+                                   kModel,
+                                   "--camera",
+                                   kCamera,
+                                   "--prior",
+                                   "3,1.5,20",
+                                   "--height",
+                                   "1.3",
+                                   "--target",
+                                   "9.25,2.75,1.5",
+                                   "--head-start-offset",
+                                   "10,5",
+                                   "--duration",
+                                   "100000",
+                                   "--snapshot-every",
+                                   "0",
+                                   "--out",
+                                   out_.string()};
+  std::vector<char*> argv;
+  for (std::string& a : args)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  // Wait (blocking read, no sleep) until the first frame has been processed.
+  std::string err;
+  char buffer[256];
+  while (err.find("live: first frame") == std::string::npos) {
+    const ssize_t n = read(pipe_fds[0], buffer, sizeof(buffer));
+    ASSERT_GT(n, 0) << "linetrack ended before its first frame: " << err;
+    err.append(buffer, static_cast<size_t>(n));
+  }
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  while (read(pipe_fds[0], buffer, sizeof(buffer)) > 0) {
+  }
+  close(pipe_fds[0]);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+
+  const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
+  EXPECT_EQ(summary["stop_reason"], "signal SIGINT");
+  EXPECT_EQ(summary["interrupted"], true);
+  EXPECT_EQ(summary["head_stopped_at_end"], true);
+  const std::vector<std::string> rows = Lines(ReadAll(out_ / "frames.csv"));
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(static_cast<long>(rows.size()) - 1, summary["frames"].get<long>());
+  for (size_t k = 1; k < rows.size(); ++k) {
+    EXPECT_EQ(CsvFields(rows[k]).size(), static_cast<size_t>(kCsvColumns)) << rows[k];
+  }
+  EXPECT_EQ(ParseTum(ReadAll(out_ / "poses.txt"), "poses.txt").size(), rows.size() - 1);
+}
+
+}  // namespace
+}  // namespace linetrack
