@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
   app::AddLive(cli, &action);
+  app::AddBenchServo(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -25,6 +25,7 @@
 #include "tracking/head/head_factory.h"
 #include "tracking/head/head_pointing.h"
 #include "tracking/live/live_overlay.h"
+#include "tracking/live/servo_bench.h"
 #include "tracking/live/sim_rig.h"
 
 namespace linetrack::app {
@@ -68,12 +69,6 @@ class StopSignals {
  private:
   struct sigaction old_int_ = {}, old_term_ = {};
 };
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, static_cast<size_t>(q * values.size()))];
-}
 
 // Everything checked before any device is opened or file written.
 struct LivePlan {
@@ -159,7 +154,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
 }
 
 nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop_reason) {
-  const double p50 = Percentile(s.loop_ms, 0.5), p95 = Percentile(s.loop_ms, 0.95);
+  const double p50 = QuantileOf(s.loop_ms, 0.5), p95 = QuantileOf(s.loop_ms, 0.95);
   return {
       {"stop_reason", stop_reason},
       {"interrupted", stop_reason.rfind("signal", 0) == 0},

@@ -1,8 +1,8 @@
 // `linetrack live --source sim --head sim` end to end, headless: the outputs (head log, poses,
 // truth, snapshots, summary) are complete and consistent, the servo converges from a 10/5 degree
 // offset, bad input exits 2 with one line and writes nothing, and SIGINT stops the run cleanly.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -66,8 +66,11 @@ std::vector<std::string> CsvFields(const std::string& row) {
 class LiveCli : public ::testing::Test {
  protected:
   void SetUp() override {
+    // Suite and test name: other CLI suites have tests of the same name and ctest runs them in
+    // parallel.
+    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
     dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+           (std::string(test->test_suite_name()) + "." + test->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     out_ = dir_ / "run";

@@ -1,0 +1,108 @@
+#include "tracking/live/servo_bench.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "models/errors.h"
+#include "tracking/live/sim_rig.h"
+
+namespace linetrack {
+namespace {
+
+constexpr double kConvergedPx = 2.0;
+
+ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig, int frames,
+                     double settle_seconds) {
+  ServoBenchRun run;
+  run.name = name;
+  run.settle_s = settle_seconds;
+  std::vector<double> settled;
+  for (int k = 0; k < frames; ++k) {
+    const LiveIteration it = rig->loop().Step();
+    if (it.grab != FrameStatus::kOk) continue;
+    ++run.frames;
+    run.loop_ms.push_back(it.loop_ms);
+    run.estimate_ms.push_back(it.estimate_ms);
+    run.grab_ms.push_back(it.grab_ms);
+    const double error = rig->TrueErrorPx();
+    if (k == 0) run.start_error_px = error;
+    if (run.convergence_s < 0.0 && error >= 0.0 && error < kConvergedPx) run.convergence_s = it.t;
+    run.final_error_px = error;
+    if (it.t >= settle_seconds) settled.push_back(error);
+  }
+  if (!settled.empty()) {
+    double sum = 0.0;
+    for (double e : settled)
+      sum += e;
+    run.mean_error_px = sum / settled.size();
+    run.p95_error_px = QuantileOf(settled, 0.95);
+    run.max_error_px = *std::max_element(settled.begin(), settled.end());
+  }
+  return run;
+}
+
+}  // namespace
+
+bool ServoBenchOptions::Check(std::string* why) const {
+  if (!(fps > 0.0 && fps <= 1000.0)) {
+    *why = "fps must be in (0, 1000]";
+    return false;
+  }
+  if (!(still_seconds >= 0.0 && drive_seconds >= 0.0 && still_seconds + drive_seconds > 0.0 &&
+        still_seconds < 1e5 && drive_seconds < 1e5)) {
+    *why = "run lengths must be >= 0 s, not both 0";
+    return false;
+  }
+  if (!(settle_seconds >= 0.0)) {
+    *why = "settle time must be >= 0 s";
+    return false;
+  }
+  return servo.Check(why) && jitter.Check(why);
+}
+
+double QuantileOf(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
+  return values[std::min(values.size() - 1, rank > 0 ? rank - 1 : 0)];
+}
+
+std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const NavigableArea& area,
+                                         const CameraIntrinsics& camera,
+                                         const ServoBenchOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw InputError("bench servo: " + why);
+  SimCameraOptions sim;
+  sim.fps = options.fps;
+  sim.render = options.render;
+  sim.head_model = options.servo.model;
+  LiveLoopOptions loop;
+  loop.servo = options.servo;
+  std::vector<ServoBenchRun> runs;
+  if (options.still_seconds > 0.0) {
+    sim.path = SimPath::kStill;
+    sim.still_base = options.still_base;
+    loop.target = options.still_target;
+    SimHeadStart start;
+    start.offset_from_target = Eigen::Vector2d(options.start_pan_offset, options.start_tilt_offset);
+    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
+                         options.jitter);
+    runs.push_back(RunOne("still", &rig,
+                          static_cast<int>(std::lround(options.still_seconds * options.fps)),
+                          options.still_seconds / 2));
+  }
+  if (options.drive_seconds > 0.0) {
+    sim.path = SimPath::kLoop;
+    loop.target = options.drive_target;
+    SimHeadStart start;
+    start.offset_from_target = Eigen::Vector2d::Zero();
+    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
+                         options.jitter);
+    runs.push_back(RunOne("drive", &rig,
+                          static_cast<int>(std::lround(options.drive_seconds * options.fps)),
+                          options.settle_seconds));
+  }
+  return runs;
+}
+
+}  // namespace linetrack
