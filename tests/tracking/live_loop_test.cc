@@ -15,6 +15,9 @@
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
 #include "tracking/head/head_pointing.h"
+#include "tracking/head/ptu_driver.h"
+#include "tracking/head/ptu_emulator.h"
+#include "tracking/head/ptu_protocol.h"
 #include "tracking/live/live_loop.h"
 #include "tracking/live/sim_camera.h"
 #include "tracking/live/sim_rig.h"
@@ -211,6 +214,72 @@ TEST(LiveLoop, StopsTheHeadWhenThePoseIsLostAndResumesAfter) {
   EXPECT_EQ(summary.recoveries, 1);
   EXPECT_LT(it.servo.error_px, kMaxFinalErrorPx);  // converged again after the cap
   EXPECT_FALSE(std::isnan(capped_pan));
+}
+
+// The same loop driving a PTU-D46 through its serial protocol (the emulator on a pseudo-terminal,
+// clock advanced one frame period per frame): the servo's rates reach the unit as signed CV
+// speeds with the right signs, and the target converges within 2 px despite whole-count speeds.
+TEST(LiveLoop, ServosAPtuThroughItsSerialProtocol) {
+  std::string why;
+  const std::unique_ptr<PtuEmulator> emulator = PtuEmulator::Start({}, &why);
+  ASSERT_TRUE(emulator) << why;
+  PtuOptions ptu;
+  ptu.device = emulator->device_path();
+  HeadResult opened;
+  const std::unique_ptr<PtuDriver> driver = PtuDriver::Open(ptu, &opened);
+  ASSERT_TRUE(driver) << opened.message;
+
+  const SimCameraOptions options = StillBase({3.0, 1.5, DegToRad(20.0)});
+  SimulatedCamera camera(Hall(), &HallArea(), PaperCamera(), options);
+  double pan = 0.0, tilt = 0.0;
+  ASSERT_TRUE(HeadAnglesLookingAt(camera.geometry(),
+                                  WorldFromHeadBase(camera.BaseAt(0.0), camera.crossing_height()),
+                                  kPillarCorner, &pan, &tilt));
+  const double arcsec = driver->unit().pan_resolution_arcsec;
+  emulator->SetPositions(std::round(PtuRadiansToCounts(pan + DegToRad(10.0), arcsec, 1)),
+                         std::round(PtuRadiansToCounts(tilt + DegToRad(5.0), arcsec, -1)));
+  PtuEmulator* unit = emulator.get();
+  camera.AttachHead(driver.get(), [unit](double dt) { unit->Advance(dt); });
+  SimulatorTruthEstimator truth(&camera);
+  LiveLoopOptions loop_options;
+  loop_options.target = kPillarCorner;
+  loop_options.crossing_height = camera.crossing_height();
+  LiveLoop loop(
+      &camera, driver.get(), &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
+      PaperCamera(), loop_options);
+  LiveIteration it;
+  double start_error_px = 0.0, late_max_error_px = 0.0;
+  for (int k = 0; k < 150; ++k) {  // 5 s
+    it = loop.Step();
+    ASSERT_EQ(it.grab, FrameStatus::kOk) << camera.LastError();
+    ASSERT_TRUE(it.servo.ok) << it.servo.reason;
+    EXPECT_TRUE(it.command == HeadCommand::kNone || it.command_result.ok())
+        << it.command_result.message;
+    const double error_px =
+        (PaperCamera().Project(camera.last_cam_from_world() * kPillarCorner) - loop.desired_px())
+            .norm();
+    if (k == 0) start_error_px = error_px;
+    if (it.t >= 4.0) late_max_error_px = std::max(late_max_error_px, error_px);
+  }
+  EXPECT_GT(start_error_px, 150.0);
+  EXPECT_LT(late_max_error_px, kMaxFinalErrorPx);
+  ASSERT_TRUE(loop.SafeStop().ok());
+  const std::vector<std::string> sent = emulator->commands();
+  // The first servo command turns right (negative pan counts) and up (positive tilt counts on a
+  // D46): the start was 10 deg left of and 5 deg below the target.
+  const auto velocity_mode = std::find(sent.begin(), sent.end(), "CV");
+  auto first_speed = [&](const char* axis) {
+    for (auto c = velocity_mode; c != sent.end(); ++c) {
+      if (c->rfind(axis, 0) == 0 && c->size() > 2 && *c != std::string(axis) + "0") {
+        return std::stol(c->substr(2));
+      }
+    }
+    return 0L;
+  };
+  ASSERT_NE(velocity_mode, sent.end());
+  EXPECT_LT(first_speed("PS"), 0L);
+  EXPECT_GT(first_speed("TS"), 0L);
+  EXPECT_EQ(sent.back(), "TS0");  // the safe stop: H PS0 TS0
 }
 
 TEST(LiveLoop, TargetDefaultsToTheCentroidOfTheVisibleModel) {

@@ -176,17 +176,36 @@ bool SimulatedCamera::CappedAt(double t) const {
   return t >= options_.cap_from_s && t < options_.cap_to_s;
 }
 
+void SimulatedCamera::AttachHead(SimulatedHead* head) {
+  AttachHead(head, [head](double dt) { head->Step(dt); });
+}
+
+void SimulatedCamera::AttachHead(PanTiltHead* head, std::function<void(double)> advance) {
+  head_ = head;
+  advance_head_ = std::move(advance);
+}
+
 std::string SimulatedCamera::LastError() const {
-  return head_ ? std::string() : "no simulated head attached";
+  if (head_ == nullptr) return "no head attached";
+  return last_error_;
 }
 
 FrameStatus SimulatedCamera::Grab(Frame* frame) {
   if (head_ == nullptr) return FrameStatus::kDeviceLost;
   const double period = 1.0 / options_.fps;
-  if (next_index_ > 0) head_->Step(period);
+  if (head_clock_index_ < next_index_) {  // once per frame, even when a read fails
+    advance_head_(period);
+    head_clock_index_ = next_index_;
+  }
   const double t = next_index_ * period;
   HeadState state;
-  head_->Read(&state);
+  const HeadResult read = head_->Read(&state);
+  if (!read.ok()) {
+    last_error_ = "head read failed: " + read.message;
+    ++stats_.losses;
+    return FrameStatus::kDeviceLost;
+  }
+  last_error_.clear();
   last_time_ = t;
   last_pan_ = state.pan;
   last_tilt_ = state.tilt;

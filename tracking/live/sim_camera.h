@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -63,11 +64,14 @@ class SimulatedCamera : public FrameSource {
                   const CameraIntrinsics& camera, const SimCameraOptions& options);
   ~SimulatedCamera() override;
 
-  // The head the camera sits on (not owned).
-  void AttachHead(SimulatedHead* head) { head_ = head; }
+  // The head the camera sits on (not owned): the simulated head, stepped by the camera.
+  void AttachHead(SimulatedHead* head);
+  // Any head whose clock `advance` moves forward by the given seconds (the PTU emulator behind a
+  // PtuDriver, for instance); the camera reads the head's angles through Read().
+  void AttachHead(PanTiltHead* head, std::function<void(double)> advance);
 
   // Frame k is taken at t = k / fps: the head is stepped to t, read, and the view rendered.
-  // kDeviceLost while no head is attached.
+  // kDeviceLost while no head is attached or when it cannot be read (LastError says why).
   FrameStatus Grab(Frame* frame) override;
   std::string LastError() const override;
   std::string Describe() const override;
@@ -96,18 +100,21 @@ class SimulatedCamera : public FrameSource {
 
   SimCameraOptions options_;
   CameraIntrinsics camera_;
-  SimulatedHead* head_ = nullptr;
+  PanTiltHead* head_ = nullptr;
+  std::function<void(double)> advance_head_;
   HeadGeometry geometry_;
   double crossing_height_ = 0.0;
   std::unique_ptr<SceneRenderer> renderer_;  // null when not rendering
   std::vector<Pose3Dof> loop_bases_;         // one lap, one per frame
   std::vector<Pose3Dof> loop_odometry_;
   std::int64_t next_index_ = 0;
+  std::int64_t head_clock_index_ = 0;  // the frame the head's clock has been advanced to
   SourceStats stats_;
   double last_time_ = 0.0;
   Eigen::Isometry3d last_cam_from_world_ = Eigen::Isometry3d::Identity();
   double last_pan_ = 0.0, last_tilt_ = 0.0;
   bool last_capped_ = false;
+  std::string last_error_;
 };
 
 }  // namespace linetrack
