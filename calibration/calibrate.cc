@@ -180,7 +180,7 @@ CalibrationResult CalibrateDetections(const std::vector<std::string>& names,
       ViewReport& v = result.views[used[k]];
       v.estimate_index = static_cast<int>(k);
       v.error_visp_without = result.visp.view_error_without[k];
-      v.error_visp = result.visp.view_error_with[k];
+      v.error_visp = result.visp.view_error_final[k];
       v.error_opencv = result.opencv.view_error[k];
     }
     const int outlier = options.reject_outliers

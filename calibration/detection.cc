@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 namespace linetrack {
@@ -35,6 +36,21 @@ double Percentile(std::vector<float> values, double fraction) {
   return values[k];
 }
 
+// Smallest distance between grid neighbours (pixels) of corners ordered row by row.
+double MinCornerSpacing(const std::vector<cv::Point2f>& corners, int cols, int rows) {
+  double spacing = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < cols; ++j) {
+      const cv::Point2f& p = corners[static_cast<size_t>(i * cols + j)];
+      if (j + 1 < cols)
+        spacing = std::min(spacing, cv::norm(p - corners[static_cast<size_t>(i * cols + j + 1)]));
+      if (i + 1 < rows)
+        spacing = std::min(spacing, cv::norm(p - corners[static_cast<size_t>((i + 1) * cols + j)]));
+    }
+  }
+  return spacing;
+}
+
 bool DetectChessboard(const cv::Mat& gray, const PatternSpec& pattern,
                       const DetectionOptions& options, std::vector<cv::Point2f>* corners) {
   const cv::Size size(pattern.cols, pattern.rows);
@@ -47,7 +63,8 @@ bool DetectChessboard(const cv::Mat& gray, const PatternSpec& pattern,
       gray, size, *corners,
       cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE);
   if (!found) return false;
-  const int w = options.subpix_half_window;
+  const int w = SubpixHalfWindow(options.subpix_half_window,
+                                 MinCornerSpacing(*corners, pattern.cols, pattern.rows));
   cv::cornerSubPix(gray, *corners, cv::Size(w, w), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT,
                                     options.subpix_iterations, options.subpix_epsilon));
@@ -78,6 +95,12 @@ bool DetectCharuco(const cv::Mat& gray, const PatternSpec& pattern, const Detect
 }
 
 }  // namespace
+
+int SubpixHalfWindow(int configured, double min_spacing_px) {
+  if (!std::isfinite(min_spacing_px)) return configured;
+  const long half_spacing = std::lround(0.5 * min_spacing_px);
+  return static_cast<int>(std::clamp<long>(half_spacing, 2, configured));
+}
 
 bool DetectionOptions::Check(std::string* why) const {
   if (subpix_half_window < 1 || subpix_half_window > 50) {

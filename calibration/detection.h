@@ -36,6 +36,11 @@ struct PatternDetection {
   double edge_blur_px = 0.0;  // EstimateEdgeBlur over the pattern (0 when not found)
 };
 
+// The cornerSubPix half window used for a board whose nearest corners are `min_spacing_px`
+// apart: the configured one, shrunk to round(spacing / 2) (at least 2) so that the window never
+// takes in the neighbouring corners (an 11 px half window on 14 px squares errs by up to 6 px).
+int SubpixHalfWindow(int configured, double min_spacing_px);
+
 // Detects `pattern` in an 8-bit grey image. Throws cv::Exception only on OpenCV faults.
 PatternDetection DetectPattern(const cv::Mat& gray, const PatternSpec& pattern,
                                const DetectionOptions& options);

@@ -83,7 +83,7 @@ std::string VispCameraXml(const CalibrationResult& result, const CalibrationOpti
   std::error_code ec;
   const fs::path tmp = fs::temp_directory_path(ec) /
                        ("linetrack-calibrate-" + std::to_string(::getpid()) + "-camera.xml");
-  CameraIntrinsics plain = result.visp.without, distorted = result.visp.with;
+  CameraIntrinsics plain = result.visp.without, distorted = result.visp.final_model;
   plain.name = distorted.name = camera_name;
   WriteCameraXml(tmp.string(), plain, distorted, AdditionalInfo(result, options));
   const std::string text = ReadWholeFile(tmp);
@@ -158,7 +158,7 @@ std::string ReportJson(const CalibrationResult& result, const CalibrationOptions
                          {"edge_blur_px", v.detection.edge_blur_px},
                          {"error_px",
                           {{"visp_without_distortion", ErrorJson(v.error_visp_without)},
-                           {"visp_with_distortion", ErrorJson(v.error_visp)},
+                           {"visp_with_distortion_final", ErrorJson(v.error_visp)},
                            {"opencv", ErrorJson(v.error_opencv)}}}};
     if (v.status != ViewStatus::kUsed) {
       view["reason"] = v.reason;
@@ -170,11 +170,14 @@ std::string ReportJson(const CalibrationResult& result, const CalibrationOptions
   const OpenCvCalibration& cv = result.opencv;
   ordered_json visp_with = IntrinsicsJson(vi.with);
   visp_with["global_error_px"] = vi.global_error_with;
-  visp_with["std_dev"] = {{"px", vi.std_dev_with(0)},
-                          {"py", vi.std_dev_with(1)},
-                          {"u0", vi.std_dev_with(2)},
-                          {"v0", vi.std_dev_with(3)},
-                          {"kud", vi.std_dev_with(4)}};
+  ordered_json visp_final = IntrinsicsJson(vi.final_model);
+  visp_final["refined"] = vi.refined;
+  visp_final["rms_px"] = vi.rms_final;
+  visp_final["std_dev"] = {{"px", vi.std_dev(0)},
+                           {"py", vi.std_dev(1)},
+                           {"u0", vi.std_dev(2)},
+                           {"v0", vi.std_dev(3)},
+                           {"kud", vi.std_dev(4)}};
   ordered_json visp_without = IntrinsicsJson(vi.without);
   visp_without["global_error_px"] = vi.global_error_without;
   const char* names[] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
@@ -185,21 +188,23 @@ std::string ReportJson(const CalibrationResult& result, const CalibrationOptions
                          {"fy", cv.fy},       {"cx", cv.cx},
                          {"cy", cv.cy},       {"distortion_k1_k2_p1_p2_k3", cv.distortion},
                          {"rms_px", cv.rms},  {"std_dev", std_dev}};
-  ordered_json report = {
-      {"image_size", {result.width, result.height}},
-      {"pattern", pattern},
-      {"detection", detection},
-      {"outlier_rejection",
-       {{"enabled", options.reject_outliers},
-        {"factor", options.outlier_factor},
-        {"min_error_px", options.outlier_min_error_px},
-        {"rounds", result.rejection_rounds}}},
-      {"views_total", result.views.size()},
-      {"views_used", result.UsedViews()},
-      {"views_rejected", rejected},
-      {"views", views},
-      {"visp", {{"without_distortion", visp_without}, {"with_distortion", visp_with}}},
-      {"opencv", opencv}};
+  ordered_json report = {{"image_size", {result.width, result.height}},
+                         {"pattern", pattern},
+                         {"detection", detection},
+                         {"outlier_rejection",
+                          {{"enabled", options.reject_outliers},
+                           {"factor", options.outlier_factor},
+                           {"min_error_px", options.outlier_min_error_px},
+                           {"rounds", result.rejection_rounds}}},
+                         {"views_total", result.views.size()},
+                         {"views_used", result.UsedViews()},
+                         {"views_rejected", rejected},
+                         {"views", views},
+                         {"visp",
+                          {{"without_distortion", visp_without},
+                           {"with_distortion_visp", visp_with},
+                           {"with_distortion", visp_final}}},
+                         {"opencv", opencv}};
   return report.dump(2) + "\n";
 }
 
@@ -246,10 +251,10 @@ std::string OverlayPng(const CalibrationResult& result, const CalibrationOptions
   if (used && v.estimate_index >= 0) {
     const std::vector<Eigen::Vector3d> board = BoardPoints(options.pattern);
     const Eigen::Isometry3d& pose =
-        result.visp.cam_from_board_with[static_cast<size_t>(v.estimate_index)];
+        result.visp.cam_from_board_final[static_cast<size_t>(v.estimate_index)];
     for (int id : v.detection.point_ids) {
       const Eigen::Vector2d uv =
-          ProjectBoardPoint(result.visp.with, pose, board[static_cast<size_t>(id)]);
+          ProjectBoardPoint(result.visp.final_model, pose, board[static_cast<size_t>(id)]);
       cv::drawMarker(
           canvas,
           cv::Point(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y()))),

@@ -67,45 +67,83 @@ CameraIntrinsics WithIntrinsics(CameraIntrinsics c, const Eigen::Matrix<double, 
   return c;
 }
 
-// Pose moved by a rotation vector (applied on the left) and a translation step.
-Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& pose, int k, double step) {
+// Pose moved by a rotation vector w (applied on the left: R' = exp(w) R) and t' = t + dt,
+// step = (w, dt).
+Eigen::Isometry3d PoseStep(const Eigen::Isometry3d& pose, const Eigen::Matrix<double, 6, 1>& step) {
   Eigen::Isometry3d out = pose;
-  if (k < 3) {
-    Eigen::Vector3d w = Eigen::Vector3d::Zero();
-    w(k) = step;
-    out.linear() = Eigen::AngleAxisd(step, w.normalized()).toRotationMatrix() * pose.linear();
-  } else {
-    out.translation()(k - 3) += step;
+  const Eigen::Vector3d w = step.head<3>();
+  if (w.norm() > 0.0) {
+    out.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * pose.linear();
   }
+  out.translation() += step.tail<3>();
   return out;
 }
 
-}  // namespace
-
-double RmsDistance(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
-  if (a.empty() || a.size() != b.size()) return 0.0;
-  double sum = 0.0;
-  for (size_t i = 0; i < a.size(); ++i)
-    sum += (a[i] - b[i]).squaredNorm();
-  return std::sqrt(sum / static_cast<double>(a.size()));
-}
-
-double PooledRms(const std::vector<double>& view_rms, const std::vector<int>& counts) {
-  double sum = 0.0, n = 0.0;
-  for (size_t i = 0; i < view_rms.size() && i < counts.size(); ++i) {
-    sum += counts[i] * view_rms[i] * view_rms[i];
-    n += counts[i];
+// All residuals (projection - measurement, u then v, view by view).
+Eigen::VectorXd Residuals(const std::vector<BoardView>& views, const CameraIntrinsics& camera,
+                          const std::vector<Eigen::Isometry3d>& cam_from_board) {
+  int n = 0;
+  for (const BoardView& v : views)
+    n += 2 * static_cast<int>(v.board_points.size());
+  Eigen::VectorXd r(n);
+  int row = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (size_t i = 0; i < views[v].board_points.size(); ++i, row += 2) {
+      r.segment<2>(row) = ProjectBoardPoint(camera, cam_from_board[v], views[v].board_points[i]) -
+                          views[v].image_points[i];
+    }
   }
-  return n > 0.0 ? std::sqrt(sum / n) : 0.0;
+  return r;
 }
+
+// Residuals and their central-difference Jacobian over (px, py, u0, v0, kud) then 6 parameters
+// per pose (PoseStep). False when there are no more residuals than parameters.
+bool ResidualsAndJacobian(const std::vector<BoardView>& views, const CameraIntrinsics& camera,
+                          const std::vector<Eigen::Isometry3d>& cam_from_board,
+                          Eigen::VectorXd* residual, Eigen::MatrixXd* jacobian) {
+  constexpr int kIntrinsics = 5;
+  const int params = kIntrinsics + 6 * static_cast<int>(views.size());
+  *residual = Residuals(views, camera, cam_from_board);
+  if (residual->size() <= params) return false;
+  jacobian->setZero(residual->size(), params);
+  const Eigen::Matrix<double, 5, 1> x0 = IntrinsicVector(camera);
+  const Eigen::Matrix<double, 5, 1> steps(1e-4 * camera.px, 1e-4 * camera.py, 1e-3, 1e-3, 1e-6);
+  constexpr double kPoseStep = 1e-6;  // radians and metres
+  int row = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (size_t i = 0; i < views[v].board_points.size(); ++i, row += 2) {
+      const Eigen::Vector3d& p = views[v].board_points[i];
+      for (int k = 0; k < kIntrinsics; ++k) {
+        Eigen::Matrix<double, 5, 1> plus = x0, minus = x0;
+        plus(k) += steps(k);
+        minus(k) -= steps(k);
+        jacobian->block<2, 1>(row, k) =
+            (ProjectBoardPoint(WithIntrinsics(camera, plus), cam_from_board[v], p) -
+             ProjectBoardPoint(WithIntrinsics(camera, minus), cam_from_board[v], p)) /
+            (2.0 * steps(k));
+      }
+      for (int k = 0; k < 6; ++k) {
+        Eigen::Matrix<double, 6, 1> step = Eigen::Matrix<double, 6, 1>::Zero();
+        step(k) = kPoseStep;
+        jacobian->block<2, 1>(row, kIntrinsics + 6 * static_cast<int>(v) + k) =
+            (ProjectBoardPoint(camera, PoseStep(cam_from_board[v], step), p) -
+             ProjectBoardPoint(camera, PoseStep(cam_from_board[v], -step), p)) /
+            (2.0 * kPoseStep);
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
 
 bool VispCalibrationOptions::Check(std::string* why) const {
   if (!(gain > 0.0 && gain <= 1.0)) {
     *why = "ViSP calibration gain must be within (0, 1]";
     return false;
   }
-  if (!std::isfinite(aspect_ratio)) {
-    *why = "aspect ratio must be finite";
+  if (refine_iterations < 1) {
+    *why = "refinement needs at least one iteration";
     return false;
   }
   return true;
@@ -132,7 +170,6 @@ VispCalibration CalibrateWithVisp(const std::vector<BoardView>& views, int width
     std::vector<vpCalibration> calibrators;
     for (const BoardView& view : views) {
       vpCalibration calib;
-      if (options.aspect_ratio > 0.0) calib.setAspectRatio(options.aspect_ratio);
       calib.clearPoint();
       for (size_t i = 0; i < view.board_points.size(); ++i) {
         const Eigen::Vector3d& p = view.board_points[i];
@@ -164,10 +201,10 @@ VispCalibration CalibrateWithVisp(const std::vector<BoardView>& views, int width
     std::vector<Eigen::Isometry3d> poses_without;
     for (const vpCalibration& c : calibrators) {
       poses_without.push_back(ToIsometry(c.cMo));
-      result.cam_from_board_with.push_back(ToIsometry(c.cMo_dist));
+      result.cam_from_board_final.push_back(ToIsometry(c.cMo_dist));
     }
     result.view_error_without = ViewErrors(views, result.without, poses_without);
-    result.view_error_with = ViewErrors(views, result.with, result.cam_from_board_with);
+    result.view_error_with = ViewErrors(views, result.with, result.cam_from_board_final);
   } catch (const vpException& e) {
     result.failure = std::string("ViSP calibration failed: ") + e.getMessage();
     return result;
@@ -177,57 +214,96 @@ VispCalibration CalibrateWithVisp(const std::vector<BoardView>& views, int width
     result.failure = "ViSP calibration diverged (non-finite or non-positive focal length)";
     return result;
   }
-  result.std_dev_with = VispModelStdDev(views, result.with, result.cam_from_board_with);
+  result.final_model = result.with;
+  if (options.refine) {
+    result.refined = RefineVispModel(views, options.refine_iterations, &result.final_model,
+                                     &result.cam_from_board_final);
+    if (result.refined) result.final_model.kdu = FitKdu(result.final_model);
+  }
+  result.view_error_final = ViewErrors(views, result.final_model, result.cam_from_board_final);
+  std::vector<int> counts;
+  for (const BoardView& v : views)
+    counts.push_back(static_cast<int>(v.board_points.size()));
+  result.rms_final = PooledRms(result.view_error_final, counts);
+  result.std_dev = VispModelStdDev(views, result.final_model, result.cam_from_board_final);
   result.ok = true;
   return result;
+}
+
+bool RefineVispModel(const std::vector<BoardView>& views, int iterations, CameraIntrinsics* camera,
+                     std::vector<Eigen::Isometry3d>* cam_from_board) {
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd residual;
+  if (!ResidualsAndJacobian(views, *camera, *cam_from_board, &residual, &jacobian)) return false;
+  double cost = residual.squaredNorm(), lambda = 1e-3;
+  bool improved = false;
+  for (int it = 0; it < iterations; ++it) {
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    const Eigen::VectorXd gradient = jacobian.transpose() * residual;
+    bool accepted = false;
+    while (!accepted && lambda < 1e10) {
+      Eigen::MatrixXd damped = normal;
+      damped.diagonal() += lambda * normal.diagonal();
+      const Eigen::VectorXd step = damped.ldlt().solve(-gradient);
+      const CameraIntrinsics trial_camera =
+          WithIntrinsics(*camera, IntrinsicVector(*camera) + step.head<5>());
+      std::vector<Eigen::Isometry3d> trial_poses = *cam_from_board;
+      for (size_t v = 0; v < trial_poses.size(); ++v)
+        trial_poses[v] = PoseStep(trial_poses[v], step.segment<6>(5 + 6 * static_cast<int>(v)));
+      Eigen::VectorXd trial_residual = Residuals(views, trial_camera, trial_poses);
+      const double trial_cost = trial_residual.squaredNorm();
+      if (std::isfinite(trial_cost) && trial_cost < cost) {
+        accepted = improved = true;
+        const double relative = (cost - trial_cost) / cost;
+        *camera = trial_camera;
+        *cam_from_board = trial_poses;
+        cost = trial_cost;
+        lambda = std::max(lambda * 0.1, 1e-12);
+        if (relative < 1e-12) return true;
+        ResidualsAndJacobian(views, *camera, *cam_from_board, &residual, &jacobian);
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!accepted) break;
+  }
+  return improved;
+}
+
+double FitKdu(const CameraIntrinsics& camera) {
+  constexpr int kGrid = 40;
+  double numerator = 0.0, denominator = 0.0;
+  for (int a = 0; a <= kGrid; ++a) {
+    for (int b = 0; b <= kGrid; ++b) {
+      const Eigen::Vector2d d((camera.width * a / double(kGrid) - camera.u0) / camera.px,
+                              (camera.height * b / double(kGrid) - camera.v0) / camera.py);
+      // Exact undistorted point of d: solve d = x (1 + kud |x|^2) by fixed-point iteration.
+      Eigen::Vector2d x = d;
+      for (int k = 0; k < 50; ++k)
+        x = d / (1.0 + camera.kud * x.squaredNorm());
+      const Eigen::Vector2d basis = d * d.squaredNorm();
+      numerator += basis.dot(x - d);
+      denominator += basis.squaredNorm();
+    }
+  }
+  return denominator > 0.0 ? numerator / denominator : 0.0;
 }
 
 Eigen::Matrix<double, 5, 1> VispModelStdDev(const std::vector<BoardView>& views,
                                             const CameraIntrinsics& camera,
                                             const std::vector<Eigen::Isometry3d>& cam_from_board) {
-  const int intrinsics = 5;
-  const int params = intrinsics + 6 * static_cast<int>(views.size());
-  int residuals = 0;
-  for (const BoardView& v : views)
-    residuals += 2 * static_cast<int>(v.board_points.size());
   Eigen::Matrix<double, 5, 1> std_dev = Eigen::Matrix<double, 5, 1>::Zero();
-  if (residuals <= params) return std_dev;
-
-  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(residuals, params);
-  double sse = 0.0;
-  const Eigen::Matrix<double, 5, 1> x0 = IntrinsicVector(camera);
-  const Eigen::Matrix<double, 5, 1> steps(1e-4 * camera.px, 1e-4 * camera.py, 1e-3, 1e-3, 1e-6);
-  constexpr double kPoseStep = 1e-6;  // radians and metres
-  int row = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    const BoardView& view = views[v];
-    for (size_t i = 0; i < view.board_points.size(); ++i, row += 2) {
-      const Eigen::Vector3d& p = view.board_points[i];
-      sse += (ProjectBoardPoint(camera, cam_from_board[v], p) - view.image_points[i]).squaredNorm();
-      for (int k = 0; k < intrinsics; ++k) {
-        Eigen::Matrix<double, 5, 1> plus = x0, minus = x0;
-        plus(k) += steps(k);
-        minus(k) -= steps(k);
-        jacobian.block<2, 1>(row, k) =
-            (ProjectBoardPoint(WithIntrinsics(camera, plus), cam_from_board[v], p) -
-             ProjectBoardPoint(WithIntrinsics(camera, minus), cam_from_board[v], p)) /
-            (2.0 * steps(k));
-      }
-      for (int k = 0; k < 6; ++k) {
-        const int col = intrinsics + 6 * static_cast<int>(v) + k;
-        jacobian.block<2, 1>(row, col) =
-            (ProjectBoardPoint(camera, Perturbed(cam_from_board[v], k, kPoseStep), p) -
-             ProjectBoardPoint(camera, Perturbed(cam_from_board[v], k, -kPoseStep), p)) /
-            (2.0 * kPoseStep);
-      }
-    }
-  }
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd residual;
+  if (!ResidualsAndJacobian(views, camera, cam_from_board, &residual, &jacobian)) return std_dev;
+  const int residuals = static_cast<int>(jacobian.rows()),
+            params = static_cast<int>(jacobian.cols());
   const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
   if (ldlt.info() != Eigen::Success) return std_dev;
-  const Eigen::MatrixXd covariance =
-      ldlt.solve(Eigen::MatrixXd::Identity(params, params)) * (sse / (residuals - params));
-  for (int k = 0; k < intrinsics; ++k) {
+  const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(params, params)) *
+                                     (residual.squaredNorm() / (residuals - params));
+  for (int k = 0; k < 5; ++k) {
     const double variance = covariance(k, k);
     if (!(variance >= 0.0) || !std::isfinite(variance)) return Eigen::Matrix<double, 5, 1>::Zero();
     std_dev(k) = std::sqrt(variance);

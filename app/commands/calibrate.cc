@@ -126,14 +126,18 @@ void PrintResult(const CalibrationResult& r, double detect_s, double estimate_s)
   }
   const CameraIntrinsics& a = r.visp.without;
   const CameraIntrinsics& b = r.visp.with;
+  const CameraIntrinsics& f = r.visp.final_model;
   const VispCalibration& vi = r.visp;
   std::cout << "ViSP without distortion: px " << a.px << " py " << a.py << " u0 " << a.u0 << " v0 "
             << a.v0 << ", global error " << vi.global_error_without << " px\n";
   std::cout << std::setprecision(4) << "ViSP with distortion:    px " << b.px << " py " << b.py
             << " u0 " << b.u0 << " v0 " << b.v0 << " kud " << b.kud << " kdu " << b.kdu
-            << ", global error " << vi.global_error_with << " px (std px " << vi.std_dev_with(0)
-            << " py " << vi.std_dev_with(1) << " u0 " << vi.std_dev_with(2) << " v0 "
-            << vi.std_dev_with(3) << " kud " << vi.std_dev_with(4) << ")\n";
+            << ", global error " << vi.global_error_with << " px (ViSP's estimate)\n";
+  std::cout << (vi.refined ? "refined (written):       px " : "written:                 px ")
+            << f.px << " py " << f.py << " u0 " << f.u0 << " v0 " << f.v0 << " kud " << f.kud
+            << " kdu " << f.kdu << ", RMS " << vi.rms_final << " px (std px " << vi.std_dev(0)
+            << " py " << vi.std_dev(1) << " u0 " << vi.std_dev(2) << " v0 " << vi.std_dev(3)
+            << " kud " << vi.std_dev(4) << ")\n";
   const OpenCvCalibration& o = r.opencv;
   std::cout << "OpenCV (flags " << o.flags << "):        fx " << o.fx << " fy " << o.fy << " cx "
             << o.cx << " cy " << o.cy << " k1 " << o.distortion[0] << " k2 " << o.distortion[1]
@@ -235,6 +239,8 @@ void AddCalibrationFlags(CLI::App* cmd, CalibrateCommandOptions* opt) {
                   "Views whose edge blur estimate (Gaussian sigma, px) exceeds this are rejected")
       ->capture_default_str();
   cmd->add_flag("--keep-all", opt->keep_all, "Do not reject outlier views");
+  cmd->add_flag("!--no-refine", opt->calib.visp.refine,
+                "Write ViSP's own distorted estimate (as its tutorial) instead of the refined one");
   cmd->add_option("--outlier-factor", opt->calib.outlier_factor,
                   "A view is an outlier when its RMS error exceeds this times the median")
       ->capture_default_str();
