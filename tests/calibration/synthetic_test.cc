@@ -14,11 +14,13 @@ namespace linetrack {
 namespace {
 
 constexpr double kIntrinsicsRelTol = 1e-3;  // px, py, u0, v0 within 0.1 %
-constexpr double kKudTol = 0.003;           // ViSP's kud (truth -0.22)
-constexpr double kVispOwnRelTol = 5e-3;     // ViSP's estimate before the refinement
-constexpr double kDistortionTolPx = 0.25;   // OpenCV's radial displacement vs the truth
-constexpr double kStdDevCoverage = 4.0;     // truth within 4 reported standard deviations
-constexpr double kMaxRmsPx = 0.15;          // reprojection RMS on clean renders
+// ChArUco corners (interpolateCornersCharuco) are noisier: RMS 0.125 px against 0.06 px.
+constexpr double kCharucoRelTol = 3e-3;
+constexpr double kKudTol = 0.003;          // ViSP's kud (truth -0.22)
+constexpr double kVispOwnRelTol = 5e-3;    // ViSP's estimate before the refinement
+constexpr double kDistortionTolPx = 0.25;  // OpenCV's radial displacement vs the truth
+constexpr double kStdDevCoverage = 4.0;    // truth within 4 reported standard deviations
+constexpr double kMaxRmsPx = 0.15;         // reprojection RMS on clean renders
 constexpr int kViews = 15;
 constexpr std::uint64_t kSeed = 20240611;
 
@@ -68,11 +70,11 @@ double RadialDisagreementPx(const OpenCvCalibration& m, const CameraIntrinsics& 
   return worst;
 }
 
-void ExpectIntrinsics(const CameraIntrinsics& got, const CameraIntrinsics& truth) {
-  EXPECT_NEAR(got.px, truth.px, kIntrinsicsRelTol * truth.px);
-  EXPECT_NEAR(got.py, truth.py, kIntrinsicsRelTol * truth.py);
-  EXPECT_NEAR(got.u0, truth.u0, kIntrinsicsRelTol * truth.u0);
-  EXPECT_NEAR(got.v0, truth.v0, kIntrinsicsRelTol * truth.v0);
+void ExpectIntrinsics(const CameraIntrinsics& got, const CameraIntrinsics& truth, double tol) {
+  EXPECT_NEAR(got.px, truth.px, tol * truth.px);
+  EXPECT_NEAR(got.py, truth.py, tol * truth.py);
+  EXPECT_NEAR(got.u0, truth.u0, tol * truth.u0);
+  EXPECT_NEAR(got.v0, truth.v0, tol * truth.v0);
 }
 
 std::string Describe(const CalibrationResult& r) {
@@ -95,11 +97,11 @@ std::string Describe(const CalibrationResult& r) {
 }
 
 // Checks the final ViSP model and OpenCV's model against the truth.
-void ExpectRecovered(const CalibrationResult& result, const CameraIntrinsics& truth) {
+void ExpectRecovered(const CalibrationResult& result, const CameraIntrinsics& truth, double tol) {
   SCOPED_TRACE(Describe(result));
   const CameraIntrinsics& f = result.visp.final_model;
   EXPECT_TRUE(result.visp.refined);
-  ExpectIntrinsics(f, truth);
+  ExpectIntrinsics(f, truth, tol);
   EXPECT_NEAR(f.kud, truth.kud, kKudTol);
   EXPECT_LT(result.visp.rms_final, kMaxRmsPx);
   const Eigen::Matrix<double, 5, 1> error(f.px - truth.px, f.py - truth.py, f.u0 - truth.u0,
@@ -118,7 +120,7 @@ void ExpectRecovered(const CalibrationResult& result, const CameraIntrinsics& tr
   opencv.py = cv.fy;
   opencv.u0 = cv.cx;
   opencv.v0 = cv.cy;
-  ExpectIntrinsics(opencv, truth);
+  ExpectIntrinsics(opencv, truth, tol);
   EXPECT_LT(RadialDisagreementPx(cv, truth, result), kDistortionTolPx);
   EXPECT_LT(cv.rms, kMaxRmsPx);
 }
@@ -133,7 +135,25 @@ TEST(SyntheticCalibration, ChessboardRecoversTheTruth) {
   const CalibrationResult result = Calibrate(images, options);
   ASSERT_TRUE(result.ok()) << result.message;
   EXPECT_EQ(result.UsedViews(), kViews) << Describe(result);  // no outlier on clean renders
-  ExpectRecovered(result, truth);
+  ExpectRecovered(result, truth, kIntrinsicsRelTol);
+}
+
+TEST(SyntheticCalibration, CharucoRecoversTheTruth) {
+  const CameraIntrinsics truth = TruthCamera();
+  CalibrationOptions options;
+  options.pattern.kind = PatternKind::kCharuco;
+  options.pattern.cols = 7;  // 8 x 6 squares
+  options.pattern.rows = 5;
+  options.pattern.square = 0.03;
+  BoardRenderOptions render;
+  render.noise_sigma = 1.0;
+  render.margin_squares = 0.5;
+  const auto images = RenderViews(options.pattern, truth, kViews, kSeed + 1, render);
+  ASSERT_EQ(images.size(), static_cast<size_t>(kViews));
+  const CalibrationResult result = Calibrate(images, options);
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_GE(result.UsedViews(), kViews - 1) << Describe(result);
+  ExpectRecovered(result, truth, kCharucoRelTol);
 }
 
 }  // namespace
