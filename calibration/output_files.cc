@@ -298,7 +298,8 @@ OutputFiles MakeCalibrationOutputs(const CalibrationResult& result,
 
 void WriteOutputFolder(const OutputFiles& files, const std::string& dir) {
   std::error_code ec;
-  const fs::path target = fs::absolute(dir, ec);
+  fs::path target = fs::absolute(dir, ec).lexically_normal();
+  if (target.filename().empty()) target = target.parent_path();  // "out/" -> "out"
   const fs::path staging = target.parent_path() /
                            (target.filename().string() + ".partial-" + std::to_string(::getpid()));
   auto fail = [&](const fs::path& path, const std::string& what) {

@@ -99,6 +99,8 @@ std::string Describe(const CalibrationResult& r) {
 // Checks the final ViSP model and OpenCV's model against the truth.
 void ExpectRecovered(const CalibrationResult& result, const CameraIntrinsics& truth, double tol) {
   SCOPED_TRACE(Describe(result));
+  const std::string summary = Describe(result);
+  std::printf("%s", summary.substr(summary.rfind("ViSP px")).c_str());  // figures for the docs
   const CameraIntrinsics& f = result.visp.final_model;
   EXPECT_TRUE(result.visp.refined);
   ExpectIntrinsics(f, truth, tol);
