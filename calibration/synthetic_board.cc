@@ -11,7 +11,8 @@ namespace linetrack {
 namespace {
 
 constexpr int kUndistortIterations = 20;
-constexpr int kCharucoPixelsPerSquare = 120;  // texture resolution of a ChArUco board
+constexpr double kUndistortTolerance2 = 1e-26;  // squared step in normalised units
+constexpr int kCharucoPixelsPerSquare = 120;    // texture resolution of a ChArUco board
 
 // Reflectance of the board at (X, Y) metres (board frame), or a negative value off the board.
 class BoardTexture {
@@ -74,8 +75,12 @@ Eigen::Vector2d UndistortedNormalised(const CameraIntrinsics& camera, double u, 
   const Eigen::Vector2d d((u - camera.u0) / camera.px, (v - camera.v0) / camera.py);
   if (!camera.has_distortion) return d;
   Eigen::Vector2d x = d;
-  for (int k = 0; k < kUndistortIterations; ++k)
-    x = d / (1.0 + camera.kud * x.squaredNorm());
+  for (int k = 0; k < kUndistortIterations; ++k) {
+    const Eigen::Vector2d next = d / (1.0 + camera.kud * x.squaredNorm());
+    const bool converged = (next - x).squaredNorm() < kUndistortTolerance2;
+    x = next;
+    if (converged) break;
+  }
   return x;
 }
 

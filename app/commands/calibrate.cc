@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <sstream>
@@ -114,7 +115,7 @@ void PrintResult(const CalibrationResult& r, double detect_s, double estimate_s)
                "OpenCV px\n";
   for (const ViewReport& v : r.views) {
     char line[256];
-    auto err = [](double e) { return e >= 0.0 ? e : 0.0 / 0.0; };
+    auto err = [](double e) { return e >= 0.0 ? e : std::numeric_limits<double>::quiet_NaN(); };
     std::snprintf(line, sizeof(line), "%-20s %-19s %6zu %8.2f %8.3f %10.3f %10.3f", v.name.c_str(),
                   ToString(v.status), v.detection.image_points.size(), v.detection.edge_blur_px,
                   err(v.error_visp_without), err(v.error_visp), err(v.error_opencv));
