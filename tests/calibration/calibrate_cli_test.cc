@@ -16,54 +16,24 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/support/cli_test.h"
+
 namespace linetrack {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::ReadAll;
 
 constexpr double kFileAgreement = 1e-9;  // the same number through two file formats
 
 const std::string kData = std::string(LINETRACK_TEST_DATA) + "/opencv";
 
-struct CommandRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-class CalibrateCli : public ::testing::Test {
+class CalibrateCli : public test_support::CliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" / "calibrate" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-
-  CommandRun Linetrack(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd =
-        std::string(LINETRACK_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
-    const int status = std::system(cmd.c_str());
-    CommandRun run;
-    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = ReadAll(out);
-    run.err = ReadAll(err);
-    fs::remove(out);
-    fs::remove(err);
-    return run;
-  }
-
   // Expects exit 2, one line on stderr containing `what`, and no output folder.
   void ExpectBadInput(const std::string& args, const std::string& what) {
     const fs::path out = dir_ / "out";
-    const CommandRun run = Linetrack("calibrate " + args + " --out " + out.string());
+    const test_support::CommandRun run = Linetrack("calibrate " + args + " --out " + out.string());
     EXPECT_EQ(run.code, 2) << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
     EXPECT_NE(run.err.find(what), std::string::npos) << run.err;
@@ -71,17 +41,15 @@ class CalibrateCli : public ::testing::Test {
     for (const auto& entry : fs::directory_iterator(dir_))
       EXPECT_EQ(entry.path().filename().string().find("out.partial"), std::string::npos);
   }
-
-  fs::path dir_;
 };
 
 TEST_F(CalibrateCli, OutputsLoadBackAndLeft02IsRejected) {
   ASSERT_TRUE(fs::exists(kData + "/left01.jpg"))
       << kData << " is missing: run scripts/fetch_test_data.sh " << LINETRACK_TEST_DATA;
   const fs::path out = dir_ / "left";
-  const CommandRun run = Linetrack("calibrate --images '" + kData +
-                                   "/left*.jpg' --cols 9 --rows 6 --square 0.025 --out " +
-                                   out.string() + " --name left");
+  const test_support::CommandRun run = Linetrack(
+      "calibrate --images '" + kData + "/left*.jpg' --cols 9 --rows 6 --square 0.025 --out " +
+      out.string() + " --name left");
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_NE(run.out.find("rejected left02.jpg"), std::string::npos) << run.out;
 
@@ -177,8 +145,9 @@ TEST_F(CalibrateCli, FrameSourceSequence) {
     fs::copy_file(kData + "/" + names[i] + ".jpg", dir_ / file);
   }
   const fs::path out = dir_ / "out";
-  const CommandRun run = Linetrack("calibrate --source " + (dir_ / "seq_%02d.jpg").string() +
-                                   " --frames 4 --out " + out.string());
+  const test_support::CommandRun run =
+      Linetrack("calibrate --source " + (dir_ / "seq_%02d.jpg").string() + " --frames 4 --out " +
+                out.string());
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(ReadAll(out / "report.json"));
   EXPECT_EQ(report["views_total"], 4);
