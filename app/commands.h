@@ -12,6 +12,8 @@ void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
+void AddCalibrate(CLI::App& cli, CommandAction* action);
+void AddBenchCalibrate(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 

@@ -49,6 +49,8 @@ int main(int argc, char** argv) {
   app::AddBenchCapture(cli, &action);
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
+  app::AddCalibrate(cli, &action);
+  app::AddBenchCalibrate(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "models/trajectory_io.h"
+#include "tests/support/cli_test.h"
 
 extern char** environ;
 
@@ -31,13 +32,6 @@ constexpr int kCsvColumns = 27;
 const std::string kSource = LINETRACK_SOURCE_DIR;
 const std::string kModel = kSource + "/models/hall.cao";
 const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
@@ -63,28 +57,20 @@ std::vector<std::string> CsvFields(const std::string& row) {
   return fields;
 }
 
-class LiveCli : public ::testing::Test {
+using test_support::ReadAll;
+
+class LiveCli : public test_support::CliTest {
  protected:
   void SetUp() override {
-    // Suite and test name: other CLI suites have tests of the same name and ctest runs them in
-    // parallel.
-    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           (std::string(test->test_suite_name()) + "." + test->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliTest::SetUp();
     out_ = dir_ / "run";
   }
 
   // Runs `linetrack live ARGS`; returns the exit code, stderr in *err.
   int Live(const std::string& args, std::string* err) {
-    const fs::path err_path = dir_ / "stderr.txt";
-    const std::string cmd =
-        std::string(LINETRACK_EXE) + " live " + args + " > /dev/null 2> " + err_path.string();
-    const int status = std::system(cmd.c_str());
-    *err = ReadAll(err_path);
-    fs::remove(err_path);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const test_support::CommandRun run = Linetrack("live " + args);
+    *err = run.err;
+    return run.code;
   }
 
   std::string StillSim() const {
@@ -92,7 +78,7 @@ class LiveCli : public ::testing::Test {
            " --prior 3,1.5,20 --height 1.3 --target 9.25,2.75,1.5 --out " + out_.string();
   }
 
-  fs::path dir_, out_;
+  fs::path out_;
 };
 
 TEST_F(LiveCli, SimulatedRunWritesItsOutputsAndConverges) {

@@ -15,29 +15,19 @@
 #include "app/localize_io.h"
 #include "models/camera.h"
 #include "models/robot_pose.h"
+#include "tests/support/cli_test.h"
 
 namespace linetrack {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::ReadAll;
 
 constexpr double kCmoTol = 1e-9;
 constexpr double kBoundSlack = 1e-9;
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 const std::string kModel = kSource + "/models/hall.cao";
-
-struct CommandRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   std::vector<nlohmann::json> rows;
@@ -48,35 +38,13 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   return rows;
 }
 
-class SynthCli : public ::testing::Test {
+class SynthCli : public test_support::CliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-
-  // Runs `linetrack ARGS`, capturing stdout and stderr.
-  CommandRun Linetrack(const std::string& args) {
-    const std::string out = (dir_ / "stdout.txt").string(), err = (dir_ / "stderr.txt").string();
-    const std::string cmd = std::string(LINETRACK_EXE) + " " + args + " > " + out + " 2> " + err;
-    const int status = std::system(cmd.c_str());
-    CommandRun run;
-    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = ReadAll(out);
-    run.err = ReadAll(err);
-    fs::remove(out);
-    fs::remove(err);
-    return run;
-  }
-
-  fs::path dir_;
 };
 
 TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
   const fs::path out = dir_ / "qi2";
-  const CommandRun run =
+  const test_support::CommandRun run =
       Linetrack("synth --model " + kModel + " --out " + out.string() + " --count 12 --qi 2");
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_NE(run.out.find("wrote 12 cases"), std::string::npos) << run.out;
@@ -130,7 +98,7 @@ TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
 
 TEST_F(SynthCli, SeedDecidesTheFilesAndLocalizeReadsThem) {
   auto synth = [&](const std::string& name, int seed) {
-    const CommandRun run =
+    const test_support::CommandRun run =
         Linetrack("synth --model " + kModel + " --out " + (dir_ / name).string() +
                   " --count 4 --seed " + std::to_string(seed));
     EXPECT_EQ(run.code, 0) << run.err;
@@ -141,7 +109,8 @@ TEST_F(SynthCli, SeedDecidesTheFilesAndLocalizeReadsThem) {
   EXPECT_EQ(first, synth("b", 5));  // same depth below dir_: same relative model path
   EXPECT_NE(first, synth("c", 6));
 
-  const CommandRun run = Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
+  const test_support::CommandRun run =
+      Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
   ASSERT_EQ(run.code, 0) << run.err;
   std::istringstream rows(run.out);
   std::string row;
@@ -187,7 +156,7 @@ TEST_F(SynthCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {model + " --camera /nonexistent.xml", "/nonexistent.xml"},
   };
   for (const auto& [args, what] : cases) {
-    const CommandRun run = Linetrack("synth " + args);
+    const test_support::CommandRun run = Linetrack("synth " + args);
     EXPECT_EQ(run.code, 2) << args;
     EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
