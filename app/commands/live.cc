@@ -6,11 +6,14 @@
 // heading + pan, tilt from the head), servo the head onto the target, log. SIGINT/SIGTERM stop
 // the head first, then the files are completed. Outputs: app/live_output.h, docs/live.md.
 #include <spdlog/spdlog.h>
+#include <visp3/core/vpException.h>
+#include <visp3/gui/vpDisplayX.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -41,6 +44,7 @@ struct LiveCommandOptions {
   double duration = 0.0;
   bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
   int snapshot_every = 30;
+  bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
 };
 
@@ -68,6 +72,38 @@ class StopSignals {
 
  private:
   struct sigaction old_int_ = {}, old_term_ = {};
+};
+
+// A window showing the overlay of every frame (X11 through ViSP), when a display answers.
+class LiveWindow {
+ public:
+  // Opens the window on the first image; false (headless) with *why when there is no display.
+  bool Open(const vpImage<vpRGBa>& first, std::string* why) {
+    if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0') {
+      *why = "DISPLAY is not set";
+      return false;
+    }
+    image_ = first;
+    try {
+      display_ = std::make_unique<vpDisplayX>();
+      display_->init(image_, -1, -1, "linetrack live");
+    } catch (const vpException& e) {
+      display_.reset();
+      *why = e.getMessage();
+      return false;
+    }
+    return true;
+  }
+  bool is_open() const { return display_ != nullptr; }
+  void Show(const vpImage<vpRGBa>& image) {
+    image_ = image;
+    vpDisplay::display(image_);
+    vpDisplay::flush(image_);
+  }
+
+ private:
+  vpImage<vpRGBa> image_;
+  std::unique_ptr<vpDisplayX> display_;
 };
 
 // Everything checked before any device is opened or file written.
@@ -214,6 +250,8 @@ int RunLive(const LiveCommandOptions& opt) {
   spdlog::info("live: started: source {}, head {}, estimator {}, {} s", rig.camera().Describe(),
                rig.head().Describe(), rig.estimator().Describe(), plan.duration);
   const std::vector<ProjectedEdge> no_edges;
+  LiveWindow window;
+  bool window_tried = false;
   const OcclusionTester occlusion(model);
   LiveSummary summary;
   std::string stop_reason = "duration";
@@ -238,15 +276,24 @@ int RunLive(const LiveCommandOptions& opt) {
       }
       const Eigen::Isometry3d truth = rig.camera().last_cam_from_world();
       output.Add(it, &truth);
-      if (opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0) {
-        output.Snapshot(
-            it.frame,
+      const bool snapshot =
+          opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
+      const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
+      if (snapshot || show) {
+        const vpImage<vpRGBa> overlay =
             DrawLiveOverlay(loop.last_frame().image, it,
                             it.estimate.has_pose()
                                 ? ProjectVisibleEdges(model, occlusion, *it.estimate.cam_from_world,
                                                       camera.Undistorted())
                                 : no_edges,
-                            camera, loop.desired_px()));
+                            camera, loop.desired_px());
+        if (snapshot) output.Snapshot(it.frame, overlay);
+        if (show && !window_tried) {
+          window_tried = true;
+          std::string why;
+          if (!window.Open(overlay, &why)) spdlog::warn("--display: no window ({}): headless", why);
+        }
+        if (window.is_open()) window.Show(overlay);
       }
       if (max_frames > 0 && summary.frames >= max_frames) break;
     }
@@ -306,6 +353,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--snapshot-every", opt->snapshot_every,
                   "Overlay snapshot every N frames into DIR/snapshots (0: none)")
       ->capture_default_str();
+  cmd->add_flag("--display", opt->display,
+                "Show the overlay of every frame in a window (X11); headless when none answers");
   cmd->add_option("--nav", opt->nav_path, "Navigable-area file for sim:path=loop and clutter");
   cmd->add_option("--estimator", opt->estimator,
                   "Camera pose: auto | truth (simulator's true pose, sim only)")

@@ -155,6 +155,16 @@ TEST_F(LiveCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
   EXPECT_FALSE(fs::exists(out_));
 }
 
+// --display without a reachable X server: a warning, and the run goes on headless.
+TEST_F(LiveCli, DisplayFallsBackToHeadless) {
+  ASSERT_EQ(setenv("DISPLAY", ":77", 1), 0);  // no X server there
+  std::string err;
+  EXPECT_EQ(Live(StillSim() + " --duration 0.2 --display", &err), 0) << err;
+  unsetenv("DISPLAY");
+  EXPECT_NE(err.find("headless"), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(out_ / "summary.json"));
+}
+
 // SIGINT in the middle of a long run: the head is stopped, the files are complete, and the
 // summary says the run was interrupted.
 TEST_F(LiveCli, SigintStopsTheHeadAndLeavesValidFiles) {
