@@ -282,6 +282,61 @@ TEST(LiveLoop, ServosAPtuThroughItsSerialProtocol) {
   EXPECT_EQ(sent.back(), "TS0");  // the safe stop: H PS0 TS0
 }
 
+// A simulated head that refuses velocity commands on demand (a unit answering "!").
+class RefusingHead : public PanTiltHead {
+ public:
+  explicit RefusingHead(SimulatedHead* head) : head_(head) {}
+  std::string Describe() const override { return "refusing " + head_->Describe(); }
+  HeadLimits Limits() const override { return head_->Limits(); }
+  HeadResult Read(HeadState* state) override { return head_->Read(state); }
+  HeadResult MoveTo(double pan, double tilt) override { return head_->MoveTo(pan, tilt); }
+  HeadResult SetVelocity(double pan_rate, double tilt_rate) override {
+    if (refuse) return HeadResult::Error(HeadStatus::kRejected, "Illegal Command");
+    return head_->SetVelocity(pan_rate, tilt_rate);
+  }
+  HeadResult Stop() override { return head_->Stop(); }
+  bool refuse = false;
+
+ private:
+  SimulatedHead* head_;
+};
+
+// A refused velocity command must not leave the head running on the previous one.
+TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
+  const SimCameraOptions options = StillBase({3.0, 1.5, DegToRad(20.0)});
+  SimulatedCamera camera(Hall(), &HallArea(), PaperCamera(), options);
+  double pan = 0.0, tilt = 0.0;
+  ASSERT_TRUE(HeadAnglesLookingAt(camera.geometry(),
+                                  WorldFromHeadBase(camera.BaseAt(0.0), camera.crossing_height()),
+                                  kPillarCorner, &pan, &tilt));
+  SimulatedHeadOptions head_options;
+  head_options.initial_pan = pan + DegToRad(10.0);
+  SimulatedHead sim_head(head_options);
+  RefusingHead head(&sim_head);
+  camera.AttachHead(&sim_head);
+  SimulatorTruthEstimator truth(&camera);
+  LiveLoopOptions loop_options;
+  loop_options.target = kPillarCorner;
+  loop_options.crossing_height = camera.crossing_height();
+  LiveLoop loop(
+      &camera, &head, &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
+      PaperCamera(), loop_options);
+  for (int k = 0; k < 5; ++k)
+    ASSERT_EQ(loop.Step().command, HeadCommand::kVelocity);  // turning
+  head.refuse = true;
+  const LiveIteration refused = loop.Step();
+  EXPECT_TRUE(refused.head_error);
+  EXPECT_EQ(refused.command, HeadCommand::kStop);
+  EXPECT_TRUE(refused.command_result.ok());
+  EXPECT_NE(refused.note.find("Illegal Command"), std::string::npos) << refused.note;
+  for (int k = 0; k < 15; ++k)
+    loop.Step();  // 0.5 s: latency and deceleration are over
+  HeadState state;
+  ASSERT_TRUE(sim_head.Read(&state).ok());
+  EXPECT_EQ(state.pan_rate, 0.0);
+  EXPECT_EQ(state.tilt_rate, 0.0);
+}
+
 TEST(LiveLoop, TargetDefaultsToTheCentroidOfTheVisibleModel) {
   const SimCameraOptions camera = StillBase({3.0, 1.5, DegToRad(20.0)});
   SimulatedLiveRig rig(Hall(), &HallArea(), PaperCamera(), camera, SimulatedHeadOptions{},

@@ -102,6 +102,7 @@ void LiveLoop::StopHead(const std::string& why, LiveIteration* it) {
   if (stopped_) return;  // already still: nothing to send
   it->command = HeadCommand::kStop;
   it->command_result = SafeStop();
+  if (!it->command_result.ok()) it->head_error = true;
 }
 
 void LiveLoop::Command(const ServoStep& step, LiveIteration* it) {
@@ -110,11 +111,23 @@ void LiveLoop::Command(const ServoStep& step, LiveIteration* it) {
     it->command = HeadCommand::kHold;
     it->command_result = head_->SetVelocity(0.0, 0.0);
     stopped_ = it->command_result.ok();
+    if (!stopped_) it->head_error = true;
     return;
   }
   it->command = HeadCommand::kVelocity;
   it->command_result = head_->SetVelocity(step.pan_rate, step.tilt_rate);
   stopped_ = it->command_result.ok() && step.pan_rate == 0.0 && step.tilt_rate == 0.0;
+  if (!it->command_result.ok()) {
+    // The head may still follow the previous command: stop it rather than let it run.
+    it->head_error = true;
+    it->note = "velocity command failed: " + it->command_result.message;
+    servo_.Reset();
+    const HeadResult stop = SafeStop();
+    if (stop.ok()) {
+      it->command = HeadCommand::kStop;
+      it->command_result = stop;
+    }
+  }
 }
 
 LiveIteration LiveLoop::Step() {
@@ -136,6 +149,7 @@ LiveIteration LiveLoop::Step() {
   const HeadResult read = head_->Read(&it.head);
   it.head_read = read.ok();
   if (!it.head_read) {
+    it.head_error = true;
     StopHead("head read failed: " + read.message, &it);
     it.loop_ms = MillisecondsSince(start);
     return it;
@@ -176,10 +190,7 @@ void LiveSummary::Add(const LiveIteration& it) {
   if (it.grab == FrameStatus::kTimeout) ++timeouts;
   if (it.grab == FrameStatus::kDeviceLost) ++device_lost;
   if (it.command == HeadCommand::kStop) ++stops;
-  if ((it.grab == FrameStatus::kOk && !it.head_read) ||
-      (it.command != HeadCommand::kNone && !it.command_result.ok())) {
-    ++head_errors;
-  }
+  if (it.head_error) ++head_errors;
   if (it.grab != FrameStatus::kOk) return;
   if (frames == 0) {
     start_t = it.t;

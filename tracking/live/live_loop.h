@@ -51,7 +51,7 @@ enum class HeadCommand {
   kNone,      // nothing sent (the same command as before, or the head did not answer)
   kVelocity,  // servo rates
   kHold,      // zero rates: converged
-  kStop,      // safe stop: no frame, no pose, no target or no head reading
+  kStop,      // safe stop: no frame, no pose, no target, no head reading, a refused command
 };
 
 // "none", "velocity", "hold", "stop".
@@ -70,8 +70,9 @@ struct LiveIteration {
   Eigen::Vector3d target = Eigen::Vector3d::Zero();  // world
   ServoStep servo;
   HeadCommand command = HeadCommand::kNone;
-  HeadResult command_result;
-  std::string note;  // why the head was stopped (empty otherwise)
+  HeadResult command_result;  // of the command finally sent
+  bool head_error = false;    // a head call failed on this iteration (read or command)
+  std::string note;           // why the head was stopped (empty otherwise)
   double grab_ms = 0.0;
   double estimate_ms = 0.0;
   double loop_ms = 0.0;  // everything after the grab: head read, estimate, servo, command
