@@ -12,5 +12,7 @@ void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
+void AddBenchLines(CLI::App& cli, CommandAction* action);
+void AddLines(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

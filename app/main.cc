@@ -49,6 +49,8 @@ int main(int argc, char** argv) {
   app::AddBenchCapture(cli, &action);
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
+  app::AddBenchLines(cli, &action);
+  app::AddLines(cli, &action);
 
   try {
     cli.parse(argc, argv);
