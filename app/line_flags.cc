@@ -1,6 +1,8 @@
 #include "app/line_flags.h"
 
-#include <sstream>
+#include <cmath>
+
+#include "app/cli_common.h"
 
 #include "models/errors.h"
 
@@ -22,24 +24,15 @@ LineExtractionOptions LineFlags::Options() const {
     throw InputError("--undistort: expected endpoints or image, got '" + undistortion + "'");
   }
   if (!roi.empty()) {
-    std::stringstream in(roi);
-    std::string field;
-    int values[4];
-    int n = 0;
-    while (std::getline(in, field, ',')) {
-      size_t used = 0;
-      try {
-        if (n < 4) values[n] = std::stoi(field, &used);
-      } catch (const std::exception&) {
-        used = 0;
+    const std::vector<double> v = ParseNumbers(roi, 4, "--roi");
+    for (double x : v) {
+      if (x != std::floor(x) || x < 0.0 || x > 1e6) {
+        throw InputError("--roi: expected U,V,WIDTH,HEIGHT in whole pixels, got '" + roi + "'");
       }
-      if (n >= 4 || used != field.size() || field.empty()) n = 5;
-      ++n;
     }
-    if (n != 4 || values[0] < 0 || values[1] < 0 || values[2] <= 0 || values[3] <= 0) {
-      throw InputError("--roi: expected U,V,WIDTH,HEIGHT (pixels, size > 0), got '" + roi + "'");
-    }
-    options.roi = {values[0], values[1], values[2], values[3]};
+    if (v[2] <= 0.0 || v[3] <= 0.0) throw InputError("--roi: the size must be positive");
+    options.roi = {static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2]),
+                   static_cast<int>(v[3])};
   }
   std::string why;
   if (!options.Check(&why)) throw InputError("--min-length/--roi: " + why);

@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
   app::AddSynth(cli, &action);
   app::AddBenchLines(cli, &action);
   app::AddLines(cli, &action);
+  app::AddBenchLocalizeImage(cli, &action);
 
   try {
     cli.parse(argc, argv);

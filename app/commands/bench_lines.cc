@@ -7,6 +7,7 @@
 #include <visp3/io/vpImageIo.h>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -50,10 +51,17 @@ struct FrameSet {
 };
 
 struct Figures {
-  std::vector<double> ms, segments, endpoint_errors;
+  std::vector<double> ms, segments, endpoint_errors, offsets_px, angle_errors_deg;
   int edges = 0, found = 0;          // observable pieces >= kMinEdgeLengthPx
   int all_edges = 0, all_found = 0;  // visible pieces >= kMinEdgeLengthPx (geometry only)
 };
+
+double Rms(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v)
+    sum += x * x;
+  return v.empty() ? 0.0 : std::sqrt(sum / v.size());
+}
 
 double Quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
@@ -161,6 +169,11 @@ Figures Measure(const FrameSet& set, const LineExtractionOptions& options, int r
     figures.endpoint_errors.insert(figures.endpoint_errors.end(),
                                    evaluation.endpoint_errors.begin(),
                                    evaluation.endpoint_errors.end());
+    figures.offsets_px.insert(figures.offsets_px.end(), evaluation.offsets_px.begin(),
+                              evaluation.offsets_px.end());
+    figures.angle_errors_deg.insert(figures.angle_errors_deg.end(),
+                                    evaluation.angle_errors_deg.begin(),
+                                    evaluation.angle_errors_deg.end());
   }
   return figures;
 }
@@ -176,9 +189,10 @@ std::string Row(const std::string& set, const std::string& detector, const Figur
         << 100.0 * f.found / std::max(1, f.edges) << " %) | " << f.all_found << " / " << f.all_edges
         << " (" << 100.0 * f.all_found / std::max(1, f.all_edges) << " %) | "
         << std::setprecision(2) << Quantile(f.endpoint_errors, 0.5) << " / "
-        << Quantile(f.endpoint_errors, 0.9) << " |";
+        << Quantile(f.endpoint_errors, 0.9) << " | " << Rms(f.offsets_px) << " / "
+        << Rms(f.angle_errors_deg) << " |";
   } else {
-    row << "- | - | - |";
+    row << "- | - | - | - |";
   }
   return row.str();
 }
@@ -223,11 +237,12 @@ int RunBenchLines(const BenchLinesOptions& opt) {
            "the parts of the visible edges that no clutter hides and across which the "
            "noise-free image steps by >= 8 grey levels; all visible: the projection with "
            "occlusion by the model only. Endpoint error: each end of a found observable piece "
-           "to the nearest detected endpoint.\n\n"
+           "(where it is an end of the visible edge) to the nearest detected endpoint. Line "
+           "offset and angle: detections along found pieces against the true line.\n\n"
         << "| frames | detector | median ms | p90 ms | segments (median) | observable model "
            "edges >= 40 px found | all visible edges >= 40 px found | endpoint error px "
-           "(median / p90) |\n"
-        << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+           "(median / p90) | line offset px / angle deg (RMS) |\n"
+        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const FrameSet& set : sets) {
     for (LineDetectorKind kind : detectors) {
       LineExtractionOptions options;

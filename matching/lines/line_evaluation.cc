@@ -100,6 +100,12 @@ DetectionEvaluation EvaluateDetections(const std::vector<ObservablePiece>& truth
     e.coverage = EdgeCoverage(piece.image, along);
     e.found = !along.empty() && e.coverage >= options.min_coverage;
     if (e.found) {
+      const Eigen::Vector2d direction = (piece.image.b - piece.image.a).normalized();
+      for (const Segment2& s : along) {
+        evaluation.offsets_px.push_back(std::abs(Cross2(direction, s.a - piece.image.a)));
+        evaluation.offsets_px.push_back(std::abs(Cross2(direction, s.b - piece.image.a)));
+        evaluation.angle_errors_deg.push_back(RadToDeg(LineAngle(piece.image, s)));
+      }
       const Eigen::Vector2d ends[2] = {piece.image.a, piece.image.b};
       for (int k = 0; k < 2; ++k) {
         if (!observable.true_end[k]) continue;

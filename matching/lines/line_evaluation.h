@@ -57,6 +57,9 @@ struct DetectionEvaluation {
   std::vector<EdgeDetection> edges;  // the pieces at least min_edge_length_px long
   int found = 0;
   std::vector<double> endpoint_errors;  // of the measured ends of the found pieces
+  // Line noise of the detections along found pieces: perpendicular distance of each detected
+  // endpoint from the piece's line (pixels), angle between detection and piece (degrees).
+  std::vector<double> offsets_px, angle_errors_deg;
 };
 
 // Judges `detections` against the pieces of model edges `truth` that project at least

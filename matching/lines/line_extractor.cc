@@ -230,6 +230,13 @@ LineExtraction LineExtractor::Extract(const cv::Mat& grey) {
   return result;
 }
 
+LineNoise DetectedLineNoise() {
+  LineNoise noise;
+  noise.offset_px = 1.0;
+  noise.angle_deg = 0.3;
+  return noise;
+}
+
 LineExtractorFunction MakeLineExtractorFunction(const LineExtractionOptions& options,
                                                 const std::optional<CameraIntrinsics>& camera) {
   auto extractor = std::make_shared<LineExtractor>(options, camera);
