@@ -92,7 +92,7 @@ std::string EncodePngColour(const vpImage<vpRGBa>& image) {
     }
   }
   std::vector<uchar> buffer;
-  cv::imencode(".png", bgr, buffer);
+  cv::imencode(".png", bgr, buffer, {cv::IMWRITE_PNG_COMPRESSION, 9});
   return std::string(buffer.begin(), buffer.end());
 }
 

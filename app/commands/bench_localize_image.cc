@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/localize_image.h"
 #include "app/rendered_cases.h"
 #include "matching/lines/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -45,6 +46,8 @@ struct BenchLocalizeImageOptions {
   // What the matcher is told of the focal-length error (a Zhang calibration: about 0.5 %).
   double focal_error = 0.005;
   std::string detector = LineDetectorName(LineExtractionOptions().detector);
+  std::string camera_path;  // empty: the paper's synthetic camera
+  int max_edges = 12;       // synth's acceptance of a view: 5 to this many model edges seen
   std::string out_path;
 };
 
@@ -134,6 +137,13 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   case_options.seed = opt.seed;
   case_options.clutter = opt.clutter;
   case_options.calibration_sigma = opt.calibration_sigma;
+  case_options.max_visible_edges = opt.max_edges;
+  if (!opt.camera_path.empty()) {
+    case_options.camera = ReadCameraXml(opt.camera_path);
+    if (case_options.camera.width <= 0) {
+      throw InputError(opt.camera_path + ": the camera file gives no image size");
+    }
+  }
   case_options.delta_t = bounds.delta_t;
   case_options.delta_phi = bounds.delta_phi;
   spdlog::info("rendering {} hall views", opt.count);
@@ -142,8 +152,7 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   LineExtractionOptions line_options;
   line_options.detector = *detector;
   LineExtractor extractor(line_options, case_options.camera);
-  LocalizerOptions localizer_options;
-  localizer_options.noise = DetectedLineNoise();
+  LocalizerOptions localizer_options = DetectedLineMatcherOptions({});
   localizer_options.noise.focal_relative = opt.focal_error;
   const Localizer localizer(model, &regions, &area, case_options.camera, localizer_options);
 
@@ -194,15 +203,20 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
 
   const double n = std::max<size_t>(1, cases.size());
   std::ostringstream table;
-  table << std::fixed << cases.size() << " rendered hall views (640x480, px 1000, " << opt.clutter
-        << " clutter objects, seed " << opt.seed << "), poses and QI" << opt.qi << " priors ("
-        << std::setprecision(2) << bounds.delta_t << " m, " << std::setprecision(0)
-        << RadToDeg(bounds.delta_phi) << " deg) drawn as linetrack synth draws them, calibration "
+  table << std::fixed << cases.size() << " rendered hall views ("
+        << (opt.camera_path.empty() ? "the paper's camera, 640x480, px 1000" : opt.camera_path)
+        << ", " << opt.clutter << " clutter objects, seed " << opt.seed << "), poses and QI"
+        << opt.qi << " priors (" << std::setprecision(2) << bounds.delta_t << " m, "
+        << std::setprecision(0) << RadToDeg(bounds.delta_phi)
+        << " deg) drawn as linetrack synth draws them, calibration "
         << "error sigma " << std::setprecision(3) << opt.calibration_sigma
-        << "; matcher told: line noise " << std::setprecision(1)
-        << localizer_options.noise.offset_px << " px, " << localizer_options.noise.angle_deg
-        << " deg, focal error " << std::setprecision(3) << opt.focal_error << "; detector "
-        << opt.detector << ", one thread.\n\n"
+        << "; matcher set for detected lines (DetectedLineMatcherOptions): line noise "
+        << std::setprecision(1) << localizer_options.noise.offset_px << " px, "
+        << localizer_options.noise.angle_deg << " deg, match distance "
+        << localizer_options.verification.match_distance_px << " px, "
+        << localizer_options.verification.match_angle_deg << " deg; focal error "
+        << std::setprecision(3) << opt.focal_error << "; detector " << opt.detector
+        << ", one thread.\n\n"
         << "| correct | no answer | wrong but accurate | wrong | pose within 0.2 m, 3 deg | "
            "lines ms (median / p90) | "
            "matcher ms (median / p90) | total ms (median / p90) | segments (median) | pose "
@@ -251,12 +265,18 @@ void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--focal-error", opt->focal_error,
                   "Relative focal-length uncertainty the matcher allows (localize --focal-error)")
       ->capture_default_str();
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera XML of the images (default: the paper's 640x480, px = 1000)");
+  cmd->add_option("--max-edges", opt->max_edges,
+                  "Views show 5 to this many model edges (synth's acceptance; wider lenses see "
+                  "more)")
+      ->capture_default_str();
   cmd->add_option("--detector", opt->detector, "Line detector: hough, lsd, fld, edlines")
       ->capture_default_str();
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->callback([opt, action] {
-    if (opt->count < 1 || opt->clutter < 0) {
-      throw CLI::ValidationError("--count >= 1, --clutter >= 0");
+    if (opt->count < 1 || opt->clutter < 0 || opt->max_edges < 5) {
+      throw CLI::ValidationError("--count >= 1, --clutter >= 0, --max-edges >= 5");
     }
     if (opt->qi < 1 || opt->qi > 3) throw CLI::ValidationError("--qi", "must be 1, 2 or 3");
     if (!(opt->calibration_sigma >= 0.0 && opt->calibration_sigma <= 0.2)) {

@@ -34,7 +34,7 @@ struct LocalizeOptions {
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
-  if (!opt.image_path.empty()) options.noise = DetectedLineNoise();
+  if (!opt.image_path.empty()) options = DetectedLineMatcherOptions(options);
   if (!opt.line_noise.empty()) {
     const std::vector<double> v = ParseNumbers(opt.line_noise, 2, "--line-noise");
     options.noise.offset_px = v[0];
@@ -183,7 +183,8 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   AddLineFlags(cmd, &opt->lines, false);
   cmd->add_option("--line-noise", opt->line_noise,
                   "Line noise OFFSET_PX,ANGLE_DEG for the matcher's margins (default 3,1 as in "
-                  "the paper; 1,0.3 with --image)");
+                  "the paper; with --image 1,0.3 and a 2.5 px / 2 deg match distance, "
+                  "docs/lines.md)");
   cmd->add_option("--focal-error", opt->focal_error,
                   "Relative focal-length uncertainty of the camera file")
       ->capture_default_str();

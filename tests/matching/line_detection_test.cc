@@ -8,6 +8,7 @@
 
 #include "matching/lines/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
+#include "models/errors.h"
 #include "models/render/scene_renderer.h"
 #include "models/robot_pose.h"
 
@@ -109,6 +110,92 @@ INSTANTIATE_TEST_SUITE_P(AllDetectors, DetectorOnRenderedHall,
                          [](const ::testing::TestParamInfo<LineDetectorKind>& info) {
                            return LineDetectorName(info.param);
                          });
+
+// A synthetic image: a bright rectangle on a dark background, corners known exactly.
+vpImage<unsigned char> Rectangle(int width, int height, int u0, int v0, int u1, int v1) {
+  vpImage<unsigned char> image(height, width, 40);
+  for (int v = v0; v < v1; ++v) {
+    for (int u = u0; u < u1; ++u)
+      image[v][u] = 200;
+  }
+  return image;
+}
+
+TEST(LineExtractor, FindsTheFourSidesOfARectangleWithEveryDetector) {
+  // Sides of the bright region [100, 500) x [80, 400): steps between pixels 99|100 and 499|500.
+  constexpr double kSideTolPx = 1.0;
+  const vpImage<unsigned char> image = Rectangle(640, 480, 100, 80, 500, 400);
+  const Segment2 sides[] = {{{99.5, 79.5}, {499.5, 79.5}},
+                            {{499.5, 79.5}, {499.5, 399.5}},
+                            {{99.5, 399.5}, {499.5, 399.5}},
+                            {{99.5, 79.5}, {99.5, 399.5}}};
+  for (LineDetectorKind kind : AllLineDetectors()) {
+    SCOPED_TRACE(LineDetectorName(kind));
+    LineExtractionOptions options;
+    options.detector = kind;
+    LineExtractor extractor(options);
+    const std::vector<Segment2> segments = extractor(image);
+    ASSERT_EQ(segments.size(), 4u);
+    for (const Segment2& side : sides) {
+      DetectionMatchOptions tolerance;
+      tolerance.max_offset_px = kSideTolPx;
+      EXPECT_EQ(std::count_if(segments.begin(), segments.end(),
+                              [&](const Segment2& s) {
+                                return DetectionOnEdge(side, s, tolerance) &&
+                                       EdgeCoverage(side, {s}) > 0.9;
+                              }),
+                1);
+    }
+  }
+}
+
+TEST(LineExtractor, RegionOfInterestKeepsItsLinesInImagePixels) {
+  const vpImage<unsigned char> image = Rectangle(640, 480, 100, 80, 500, 400);
+  LineExtractionOptions options;
+  options.roi = {0, 0, 320, 480};  // the left half: the left side and halves of top and bottom
+  LineExtractor extractor(options);
+  const std::vector<Segment2> segments = extractor(image);
+  ASSERT_EQ(segments.size(), 3u);
+  for (const Segment2& s : segments) {
+    EXPECT_LT(std::max(s.a.x(), s.b.x()), 320.0);
+    EXPECT_GT(std::min(s.a.x(), s.b.x()), 98.0);
+  }
+}
+
+TEST(LineExtractor, TheFunctionFormGivesTheSameSegments) {
+  const vpImage<unsigned char> image = Rectangle(640, 480, 100, 80, 500, 400);
+  const LineExtractorFunction extract = MakeLineExtractorFunction({});
+  LineExtractor extractor({});
+  const std::vector<Segment2> a = extract(image), b = extractor(image);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ(a[i].a, b[i].a);
+}
+
+TEST(LineExtractor, BadImagesAndOptionsThrowInputError) {
+  const CameraIntrinsics camera = ReadCameraXml(kPaperCamera);  // 640x480
+  LineExtractor extractor({}, camera);
+  EXPECT_THROW(extractor.Extract(vpImage<unsigned char>()), InputError);
+  EXPECT_THROW(extractor.Extract(vpImage<unsigned char>(240, 320, 0)), InputError);
+  LineExtractionOptions outside;
+  outside.roi = {600, 0, 100, 100};
+  LineExtractor roi_extractor(outside);
+  EXPECT_THROW(roi_extractor.Extract(vpImage<unsigned char>(480, 640, 0)), InputError);
+  LineExtractionOptions bad;
+  bad.min_length_px = std::nan("");
+  EXPECT_THROW(LineExtractor{bad}, InputError);
+  bad = {};
+  bad.merge_options.max_angle_deg = 95.0;
+  EXPECT_THROW(LineExtractor{bad}, InputError);
+  // A flat image has no lines (not an error).
+  EXPECT_TRUE(extractor(vpImage<unsigned char>(480, 640, 90)).empty());
+}
+
+TEST(LineDetectorName, RoundTrips) {
+  for (LineDetectorKind kind : AllLineDetectors())
+    EXPECT_EQ(ParseLineDetector(LineDetectorName(kind)), kind);
+  EXPECT_FALSE(ParseLineDetector("canny").has_value());
+}
 
 }  // namespace
 }  // namespace linetrack
