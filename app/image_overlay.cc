@@ -13,6 +13,7 @@
 
 #include "matching/lines/undistortion.h"
 #include "models/errors.h"
+#include "models/synthetic_scenes.h"
 
 namespace linetrack::app {
 
@@ -51,11 +52,15 @@ void DrawSegments(vpImage<vpRGBa>* image, const std::vector<Segment2>& segments,
     const int pieces = distorted ? std::max(1, static_cast<int>(s.Length() / 8.0)) : 1;
     auto at = [&](int k) {
       const Eigen::Vector2d p = s.a + (s.b - s.a) * (static_cast<double>(k) / pieces);
-      const Eigen::Vector2d q = distorted ? DistortedPixelOf(*camera, p) : p;
-      return vpImagePoint(q.y(), q.x());
+      return distorted ? DistortedPixelOf(*camera, p) : p;
     };
-    for (int k = 0; k < pieces; ++k)
-      vpImageDraw::drawLine(*image, at(k), at(k + 1), colour, thickness);
+    for (int k = 0; k < pieces; ++k) {
+      Segment2 piece{at(k), at(k + 1)};
+      // Only what lies inside the image is drawn.
+      if (!ClipSegmentToImage(image->getWidth(), image->getHeight(), &piece)) continue;
+      vpImageDraw::drawLine(*image, vpImagePoint(piece.a.y(), piece.a.x()),
+                            vpImagePoint(piece.b.y(), piece.b.x()), colour, thickness);
+    }
   }
 }
 
