@@ -10,6 +10,7 @@
 
 namespace linetrack::app {
 
+// The flag values, as given on the command line.
 struct LineFlags {
   std::string camera_path, camera_name;  // camera_path empty: no undistortion
   std::string detector = LineDetectorName(LineExtractionOptions().detector);

@@ -15,6 +15,7 @@
 
 namespace linetrack::app {
 
+// An image with its extracted segments.
 struct ImageLines {
   vpImage<unsigned char> image;
   CameraIntrinsics camera;         // the camera file's model (with its distortion)

@@ -19,6 +19,7 @@
 
 namespace linetrack::app {
 
+// How the cases are drawn and rendered.
 struct RenderedCaseOptions {
   int count = 50;
   uint64_t seed = 1;
@@ -34,6 +35,7 @@ struct RenderedCaseOptions {
   double min_contrast = 8.0;
 };
 
+// One rendered view with its truth.
 struct RenderedCase {
   SyntheticScene scene;           // pose drawn in the navigable area, prior, height, tilt
   CameraIntrinsics image_camera;  // the camera that made the image (focal error applied)

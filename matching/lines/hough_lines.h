@@ -13,6 +13,7 @@
 
 namespace linetrack {
 
+// Settings of the paper's extractor (defaults set on rendered hall views, docs/lines.md).
 struct HoughLineOptions {
   double blur_sigma = 1.0;  // Gaussian smoothing before the gradient (pixels); 0: none
   // Canny hysteresis thresholds on the L2 magnitude of the 3x3 Sobel gradient (a blurred step

@@ -16,6 +16,7 @@
 
 namespace linetrack {
 
+// When a detection images a projected model edge, and when the edge counts as found.
 struct DetectionMatchOptions {
   double max_angle_deg = 2.0;  // between a detection and the projected edge
   double max_offset_px = 2.0;  // both endpoints of the detection from the edge's line
@@ -33,6 +34,7 @@ bool DetectionOnEdge(const Segment2& edge, const Segment2& detection,
 // Share of `edge`'s length covered by the union of the detections' projections onto it.
 double EdgeCoverage(const Segment2& edge, const std::vector<Segment2>& detections);
 
+// One piece of model edge judged against the detections.
 struct EdgeDetection {
   int edge_id = -1;
   Segment2 edge;                // projected visible piece (undistorted pixels)
@@ -53,6 +55,7 @@ struct ObservablePiece {
   bool true_end[2] = {true, true};
 };
 
+// The judging of one image: its pieces and the figures over the found ones.
 struct DetectionEvaluation {
   std::vector<EdgeDetection> edges;  // the pieces at least min_edge_length_px long
   int found = 0;

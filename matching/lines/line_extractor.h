@@ -42,11 +42,13 @@ struct PixelRect {
   bool Empty() const { return width <= 0 || height <= 0; }
 };
 
+// cv::ximgproc::FastLineDetector settings (thresholds set on rendered views, docs/lines.md).
 struct FldOptions {
   double canny_low = 20.0, canny_high = 40.0;  // Canny thresholds (3x3 Sobel, L1)
   double distance_px = 1.414;                  // pixels off the fitted line end a segment
 };
 
+// cv::ximgproc::EdgeDrawing settings for its line detection.
 struct EdlinesOptions {
   int gradient_threshold = 10;     // edge pixels need a gradient (Prewitt) above this
   int anchor_threshold = 4;        // anchors stand this much above their neighbours
@@ -55,11 +57,13 @@ struct EdlinesOptions {
   bool nfa_validation = true;      // a contrario validation of the lines
 };
 
+// cv::LineSegmentDetector settings.
 struct LsdOptions {
   bool refine = true;  // LSD_REFINE_STD (split arcs into straight pieces) vs LSD_REFINE_NONE
   double scale = 0.8;  // image scale of the detection (Gaussian down-sampling)
 };
 
+// What LineExtractor does, in order: ROI, detection, undistortion, merging, minimum length.
 struct LineExtractionOptions {
   LineDetectorKind detector = LineDetectorKind::kFld;  // the fastest that passes (docs/lines.md)
   double min_length_px = 20.0;           // segments shorter than this after merging are dropped
@@ -78,6 +82,7 @@ struct LineExtractionOptions {
   EdlinesOptions edlines;
   LsdOptions lsd;
 
+  // Finite, positive lengths; valid merge, ROI and detector settings.
   bool Check(std::string* why) const;
 };
 
