@@ -14,5 +14,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
 void AddCalibrate(CLI::App& cli, CommandAction* action);
 void AddBenchCalibrate(CLI::App& cli, CommandAction* action);
+void AddBenchLines(CLI::App& cli, CommandAction* action);
+void AddLines(CLI::App& cli, CommandAction* action);
+void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app
