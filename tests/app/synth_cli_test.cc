@@ -108,8 +108,7 @@ TEST_F(SynthCli, SeedDecidesTheFilesAndLocalizeReadsThem) {
   EXPECT_EQ(first, synth("b", 5));  // same depth below dir_: same relative model path
   EXPECT_NE(first, synth("c", 6));
 
-  const CommandRun run =
-      Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
+  const CommandRun run = Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
   ASSERT_EQ(run.code, 0) << run.err;
   std::istringstream rows(run.out);
   std::string row;
