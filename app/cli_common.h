@@ -28,6 +28,9 @@ std::vector<double> ParseNumberList(const std::string& text, size_t count, const
 // Throws InputError naming `flag` when malformed or not finite.
 Pose3Dof ParsePrior(const std::string& text, const std::string& flag);
 
+// Parses `count` comma-separated finite numbers; throws InputError naming `flag` otherwise.
+std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag);
+
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
 void CheckRange(double value, double lo, double hi, const std::string& flag);
 

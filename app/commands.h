@@ -14,6 +14,9 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
 void AddCalibrate(CLI::App& cli, CommandAction* action);
 void AddBenchCalibrate(CLI::App& cli, CommandAction* action);
+void AddBenchLines(CLI::App& cli, CommandAction* action);
+void AddLines(CLI::App& cli, CommandAction* action);
+void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 

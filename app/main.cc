@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
   app::AddSynth(cli, &action);
   app::AddCalibrate(cli, &action);
   app::AddBenchCalibrate(cli, &action);
+  app::AddBenchLines(cli, &action);
+  app::AddLines(cli, &action);
+  app::AddBenchLocalizeImage(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
 

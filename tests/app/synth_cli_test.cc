@@ -21,6 +21,7 @@ namespace linetrack {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::CommandRun;
 using test_support::ReadAll;
 
 constexpr double kCmoTol = 1e-9;
@@ -38,13 +39,11 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   return rows;
 }
 
-class SynthCli : public test_support::CliTest {
- protected:
-};
+class SynthCli : public test_support::CliTest {};
 
 TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
   const fs::path out = dir_ / "qi2";
-  const test_support::CommandRun run =
+  const CommandRun run =
       Linetrack("synth --model " + kModel + " --out " + out.string() + " --count 12 --qi 2");
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_NE(run.out.find("wrote 12 cases"), std::string::npos) << run.out;
@@ -98,7 +97,7 @@ TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
 
 TEST_F(SynthCli, SeedDecidesTheFilesAndLocalizeReadsThem) {
   auto synth = [&](const std::string& name, int seed) {
-    const test_support::CommandRun run =
+    const CommandRun run =
         Linetrack("synth --model " + kModel + " --out " + (dir_ / name).string() +
                   " --count 4 --seed " + std::to_string(seed));
     EXPECT_EQ(run.code, 0) << run.err;
@@ -109,8 +108,7 @@ TEST_F(SynthCli, SeedDecidesTheFilesAndLocalizeReadsThem) {
   EXPECT_EQ(first, synth("b", 5));  // same depth below dir_: same relative model path
   EXPECT_NE(first, synth("c", 6));
 
-  const test_support::CommandRun run =
-      Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
+  const CommandRun run = Linetrack("localize --batch " + (dir_ / "a" / "cases.jsonl").string());
   ASSERT_EQ(run.code, 0) << run.err;
   std::istringstream rows(run.out);
   std::string row;
@@ -156,7 +154,7 @@ TEST_F(SynthCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {model + " --camera /nonexistent.xml", "/nonexistent.xml"},
   };
   for (const auto& [args, what] : cases) {
-    const test_support::CommandRun run = Linetrack("synth " + args);
+    const CommandRun run = Linetrack("synth " + args);
     EXPECT_EQ(run.code, 2) << args;
     EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
