@@ -12,5 +12,6 @@ void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
+void AddBenchTrack(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

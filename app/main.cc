@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   app::AddBenchCapture(cli, &action);
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
+  app::AddBenchTrack(cli, &action);
 
   try {
     cli.parse(argc, argv);

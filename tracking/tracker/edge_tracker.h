@@ -1,0 +1,84 @@
+// ViSP's model-based moving-edge tracker (vpMbGenericTracker, EDGE features) behind a small
+// interface: start from a pose, track a frame, measure its health. ViSP's exceptions stop here:
+// a failed call is a result with a reason. Images must be undistorted (ImageUndistorter).
+#pragma once
+
+#include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/core/vpImage.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "models/camera.h"
+#include "models/geometry.h"
+#include "tracking/tracker/tracker_settings.h"
+#include "tracking/tracker/tracking_health.h"
+
+class vpMbGenericTracker;
+
+namespace linetrack {
+
+// The outcome of Start() or Track().
+struct EdgeTrackResult {
+  bool ok = false;     // false: ViSP failed (reason says why); the pose is then meaningless
+  std::string reason;  // ViSP's message when !ok
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
+  TrackHealth health;  // measured by Track() (Start() measures nothing)
+};
+
+class EdgeTracker {
+ public:
+  // Loads the .cao model through ViSP and applies `settings` and the (undistorted) camera.
+  // Throws InputError naming the model when ViSP cannot load it, or naming the settings' source
+  // when they are invalid.
+  EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
+              const TrackerSettings& settings);
+  ~EdgeTracker();
+  EdgeTracker(const EdgeTracker&) = delete;
+  EdgeTracker& operator=(const EdgeTracker&) = delete;
+
+  // (Re)starts the tracker at `cam_from_world` on `image`: the moving edges are sampled there.
+  EdgeTrackResult Start(const vpImage<unsigned char>& image,
+                        const Eigen::Isometry3d& cam_from_world);
+
+  // Tracks `image` from the current pose (settings.passes passes) and measures the health. The pose
+  // covariance only `with_covariance`: ViSP computes it with a dense n x n weight matrix over the n
+  // moving edges, which costs several times the tracking. Needs a successful Start() since the last
+  // failure.
+  EdgeTrackResult Track(const vpImage<unsigned char>& image, bool with_covariance = false);
+
+  // True after a successful Start() and until a Track() fails.
+  bool started() const { return started_; }
+
+  // The visible parts of the model edges projected with `cam_from_world` (pixels of the
+  // undistorted image, clipped to it), as ViSP's visibility settings see them.
+  std::vector<Segment2> ProjectModel(const Eigen::Isometry3d& cam_from_world);
+
+  const TrackerSettings& settings() const { return settings_; }
+  const CameraIntrinsics& camera() const { return camera_; }
+
+ private:
+  EdgeTrackResult Measure(bool with_covariance);
+
+  std::unique_ptr<vpMbGenericTracker> tracker_;
+  CameraIntrinsics camera_;
+  TrackerSettings settings_;
+  bool started_ = false;
+};
+
+// cam_from_world <-> ViSP's cMo.
+vpHomogeneousMatrix ToVispPose(const Eigen::Isometry3d& cam_from_world);
+Eigen::Isometry3d FromVispPose(const vpHomogeneousMatrix& cMo);
+
+// Applies `settings` (moving edges, visibility, iterations) and the camera to a ViSP tracker;
+// also used to configure the bare ViSP baseline of `linetrack bench track`.
+void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsics& camera,
+                          vpMbGenericTracker* tracker);
+
+// Loads a .cao model into a ViSP tracker without ViSP's console output. Throws InputError naming
+// the file when ViSP cannot load it.
+void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker);
+
+}  // namespace linetrack
