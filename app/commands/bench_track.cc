@@ -20,7 +20,9 @@ namespace {
 struct BenchTrackOptions {
   std::string visp_images;
   int repeats = 3;
-  int passes = 0;  // 0: the settings' own
+  int passes = 0;                 // 0: the settings' own
+  double pass_step_factor = 0.0;  // 0: the settings' own
+  bool no_refinement = false;
   bool json = false;
 };
 
@@ -49,6 +51,8 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
   }
   for (BenchSequence& s : sequences) {
     if (opt.passes > 0) s.settings.passes = opt.passes;
+    if (opt.pass_step_factor > 0.0) s.settings.pass_step_factor = opt.pass_step_factor;
+    if (opt.no_refinement) s.settings.refine_subpixel = false;
     const TrackBenchResult r = RunTrackBench(s, opt.repeats);
     const double visp_median = Quantile(r.visp_ms, 0.5);
     const double ours_median = Quantile(r.linetrack_ms, 0.5);
@@ -99,6 +103,9 @@ void AddBenchTrack(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--repeats", opt->repeats, "Runs over each sequence (times pooled)")
       ->capture_default_str();
   cmd->add_option("--passes", opt->passes, "Override the minimum tracking passes per frame");
+  cmd->add_option("--pass-step-factor", opt->pass_step_factor,
+                  "Override the sample step factor of each pass");
+  cmd->add_flag("--no-refinement", opt->no_refinement, "Skip the sub-pixel refinement");
   cmd->add_flag("--json", opt->json, "Print the table as JSON");
   cmd->callback([opt, action] { *action = [opt] { return RunBenchTrack(*opt); }; });
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "models/errors.h"
+#include "models/wireframe.h"
 
 namespace linetrack {
 
@@ -95,6 +96,10 @@ EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& 
       camera_(camera.Undistorted()),
       settings_(settings) {
   LoadVispModel(model_path, tracker_.get());
+  model_ = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  occlusion_ = std::make_unique<OcclusionTester>(*model_);
+  for (const ModelEdge& edge : model_->edges())
+    edges_.push_back(edge.segment);
   try {
     ConfigureVispTracker(settings_, camera_, tracker_.get());
   } catch (const vpException& e) {
@@ -120,7 +125,26 @@ EdgeTrackResult EdgeTracker::Start(const vpImage<unsigned char>& image,
   return result;
 }
 
-EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool with_covariance) {
+EdgeTrackResult EdgeTracker::StartFromPrediction(const vpImage<unsigned char>& image,
+                                                 const Eigen::Isometry3d& predicted,
+                                                 const std::optional<KnownHeightTilt>& known) {
+  std::vector<Segment3> visible;
+  for (const ProjectedEdge& edge : ProjectVisibleEdges(*model_, *occlusion_, predicted, camera_))
+    visible.push_back(edge.world);
+  const EdgeRefinement aligned =
+      AlignToEdges(image, camera_, visible, predicted, settings_.alignment, known);
+  if (!aligned.applied) {
+    started_ = false;
+    EdgeTrackResult result;
+    result.reason = "too few image edges near the predicted pose (" +
+                    std::to_string(aligned.points) + " points)";
+    return result;
+  }
+  return Start(image, aligned.cam_from_world);
+}
+
+EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool with_covariance,
+                                   const std::optional<KnownHeightTilt>& known) {
   EdgeTrackResult result;
   if (!started_) {
     result.reason = "the tracker has not been started";
@@ -134,7 +158,7 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
       tracker_->setCovarianceComputation(last && with_covariance);
       tracker_->track(image);
     }
-    EdgeTrackResult measured = Measure(with_covariance);
+    EdgeTrackResult measured = Measure(image, with_covariance, known);
     measured.health.passes = passes;
     return measured;
   } catch (const vpException& e) {
@@ -144,16 +168,33 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
   }
 }
 
-EdgeTrackResult EdgeTracker::Measure(bool with_covariance) {
+EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool with_covariance,
+                                     const std::optional<KnownHeightTilt>& known) {
   EdgeTrackResult result;
   result.ok = true;
   result.cam_from_world = FromVispPose(tracker_->getPose());
+  result.visp_cam_from_world = result.cam_from_world;
   TrackHealth& health = result.health;
   health.projection_error_deg = tracker_->getProjectionError();
+  std::vector<Eigen::Vector2d> good_sites;
   for (const std::vector<double>& feature : tracker_->getFeaturesForDisplay()) {
-    if (feature.size() < 4 || feature[0] != 0.0) continue;  // type 0: a moving edge
+    if (feature.size() < 4 || feature[0] != 0.0)
+      continue;  // type 0: a moving edge {0, i, j, state}
     ++health.edges_total;
-    if (feature[3] == kGoodSiteState) ++health.edges_good;
+    if (feature[3] != kGoodSiteState) continue;
+    ++health.edges_good;
+    good_sites.emplace_back(feature[2], feature[1]);
+  }
+  if (settings_.refine_subpixel) {
+    const EdgeRefinement refined = RefineOnEdges(
+        image, camera_, edges_, good_sites, result.cam_from_world, settings_.refinement, known);
+    health.refined = refined.applied;
+    health.refined_points = refined.points;
+    if (refined.applied) {
+      result.cam_from_world = refined.cam_from_world;
+      health.refined_rms_before_px = refined.rms_before_px;
+      health.refined_rms_after_px = refined.rms_after_px;
+    }
   }
   if (!with_covariance) return result;
   const vpMatrix covariance = tracker_->getCovarianceMatrix();

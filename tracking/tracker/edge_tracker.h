@@ -8,11 +8,14 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "models/camera.h"
 #include "models/geometry.h"
+#include "models/occlusion.h"
+#include "models/wireframe.h"
 #include "tracking/tracker/tracker_settings.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -25,14 +28,17 @@ struct EdgeTrackResult {
   bool ok = false;     // false: ViSP failed (reason says why); the pose is then meaningless
   std::string reason;  // ViSP's message when !ok
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
+  // ViSP's own pose before the sub-pixel refinement (equal to cam_from_world without it).
+  Eigen::Isometry3d visp_cam_from_world = Eigen::Isometry3d::Identity();
   TrackHealth health;  // measured by Track() (Start() measures nothing)
 };
 
 class EdgeTracker {
  public:
-  // Loads the .cao model through ViSP and applies `settings` and the (undistorted) camera.
-  // Throws InputError naming the model when ViSP cannot load it, or naming the settings' source
-  // when they are invalid.
+  // Loads the .cao model through ViSP (and linetrack's reader, for the edges the sub-pixel
+  // refinement uses) and applies `settings` and the (undistorted) camera. Throws InputError
+  // naming the model when it cannot be loaded, or naming the settings' source when they are
+  // invalid.
   EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
               const TrackerSettings& settings);
   ~EdgeTracker();
@@ -47,7 +53,16 @@ class EdgeTracker {
   // covariance only `with_covariance`: ViSP computes it with a dense n x n weight matrix over the n
   // moving edges, which costs several times the tracking. Needs a successful Start() since the last
   // failure.
-  EdgeTrackResult Track(const vpImage<unsigned char>& image, bool with_covariance = false);
+  // With `known` (a robot's height and tilt) the refined pose respects them (3 unknowns).
+  EdgeTrackResult Track(const vpImage<unsigned char>& image, bool with_covariance = false,
+                        const std::optional<KnownHeightTilt>& known = std::nullopt);
+
+  // Aligns `predicted` (e.g. the last pose moved by the robot's odometry) on the edges of `image`
+  // (EdgeAlignmentOptions of the settings) and starts the tracker there; Track() then follows.
+  // Not ok when too few edges are found near the predicted model.
+  EdgeTrackResult StartFromPrediction(const vpImage<unsigned char>& image,
+                                      const Eigen::Isometry3d& predicted,
+                                      const std::optional<KnownHeightTilt>& known = std::nullopt);
 
   // True after a successful Start() and until a Track() fails.
   bool started() const { return started_; }
@@ -60,9 +75,13 @@ class EdgeTracker {
   const CameraIntrinsics& camera() const { return camera_; }
 
  private:
-  EdgeTrackResult Measure(bool with_covariance);
+  EdgeTrackResult Measure(const vpImage<unsigned char>& image, bool with_covariance,
+                          const std::optional<KnownHeightTilt>& known);
 
   std::unique_ptr<vpMbGenericTracker> tracker_;
+  std::unique_ptr<WireframeModel> model_;  // linetrack's reading of the model
+  std::unique_ptr<OcclusionTester> occlusion_;
+  std::vector<Segment3> edges_;  // the model's edges (world), for the sub-pixel refinement
   CameraIntrinsics camera_;
   TrackerSettings settings_;
   bool started_ = false;

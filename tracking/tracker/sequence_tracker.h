@@ -8,6 +8,7 @@
 #include <visp3/core/vpImage.h>
 
 #include <Eigen/Geometry>
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -47,9 +48,29 @@ struct SequenceTrackerOptions {
   bool restart_from_last_good = true;
   // A restart from the last good pose is tried only this many frames after it (the camera moves).
   int restart_window = 30;
+  // With odometry, the last pose is moved by the odometry's motion since the last frame and
+  // aligned on the image edges before tracking when that motion shifts the image by more than
+  // prediction_min_px (estimated for scene points prediction_depth_m away).
+  double prediction_min_px = 3.0;
+  double prediction_depth_m = 2.0;
+  // A jump of the projection error to more than jump_ratio times its median over the last
+  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
+  // (e.g. a door casing beside the modelled edge): the pose is dropped.
+  // A robot's pose must be confirmed by the sub-pixel refinement on the edges (with its height
+  // and tilt); otherwise ViSP's unconstrained pose would be reported.
+  bool robot_requires_refinement = true;
+  double jump_ratio = 3.0;
+  double jump_floor_deg = 8.0;
+  int jump_window = 15;
 
   bool Check(std::string* why) const;
 };
+
+// The camera pose now from the last pose and the robot's readings then and now (odometry position
+// and heading, height, tilt): C_now C_then^-1 last, with C = CamFromWorld of a reading. Keeps the
+// last pose's own roll and small errors; only the relative motion of the odometry is used.
+Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const RobotPose& then,
+                                      const RobotPose& now);
 
 // What happened on one frame.
 struct FrameReport {
@@ -60,6 +81,7 @@ struct FrameReport {
   std::string source;  // where the pose came from: "tracker", "start pose", "matcher", "restart"
   std::string note;    // why there is no pose (empty otherwise)
   int lines = -1;      // segments extracted when the matcher ran, else -1
+  bool predicted = false;  // tracking started from the odometry's prediction
   double undistort_ms = 0.0;
   double track_ms = 0.0;       // tracking from the previous frame
   double relocalize_ms = 0.0;  // matcher, restarts and their verification
@@ -94,7 +116,7 @@ class SequenceTracker {
   struct GoodPose {
     Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
     double t = 0.0;
-    std::optional<Pose3Dof> odometry;  // the robot's odometry at that frame
+    std::optional<RobotReading> robot;  // what the robot read at that frame
   };
 
   // Empty when the tracked result can be kept at time t, else why not.
@@ -106,6 +128,9 @@ class SequenceTracker {
   // The matcher's prior for this frame (robot only) and its bounds; false when there is none.
   bool MatcherPrior(const RobotReading& robot, RobotPose* prior, SearchBounds* bounds) const;
   int FramesSinceGood() const { return static_cast<int>(frame_index_ - last_good_index_); }
+  // With odometry now and at the last frame: restarts the tracker from the predicted pose when
+  // the predicted image motion is large.
+  void MaybePredict(const std::optional<RobotReading>& robot, FrameReport* report);
   void Accept(const EdgeTrackResult& result, double t, const std::optional<RobotReading>& robot,
               const char* source, FrameReport* report);
 
@@ -119,6 +144,7 @@ class SequenceTracker {
   std::optional<Eigen::Isometry3d> start_pose_;
   std::optional<Pose3Dof> initial_prior_;
   std::optional<GoodPose> last_good_;
+  std::deque<double> recent_projection_errors_;  // of the last good frames
   bool following_ = false;  // the tracker holds a good pose from the previous frame
   long frame_index_ = -1;   // frames processed - 1
   long last_good_index_ = -1;

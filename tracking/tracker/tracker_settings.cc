@@ -54,7 +54,9 @@ bool VisibilitySettings::Check(std::string* why) const {
 }
 
 bool TrackerSettings::Check(std::string* why) const {
-  if (!me.Check(why) || !visibility.Check(why)) return false;
+  if (!me.Check(why) || !visibility.Check(why) || !refinement.Check(why) || !alignment.Check(why)) {
+    return false;
+  }
   if (passes < 1 || passes > 10) {
     *why = "passes must be in [1, 10]";
     return false;

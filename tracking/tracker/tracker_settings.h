@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "tracking/tracker/edge_refinement.h"
+
 namespace linetrack {
 
 // ViSP's vpMe: one moving edge is searched along the normal of a projected model edge.
@@ -22,14 +24,14 @@ struct MovingEdgeSettings {
 
 // Which faces and edges are considered visible (ViSP's <face> section).
 struct VisibilitySettings {
-  double angle_appear_deg = 70.0;     // a face becomes visible below this view angle
-  double angle_disappear_deg = 80.0;  // and invisible above this one
+  double angle_appear_deg = 85.0;     // a face becomes visible below this view angle
+  double angle_disappear_deg = 89.0;  // and invisible above this one
   double near_clipping_m = 0.1;       // metres in front of the camera
   double far_clipping_m = 100.0;
   bool fov_clipping = true;  // clip faces by the field of view
   // Hidden-edge removal by scan-line rendering of the faces (occluded edge parts are not
   // tracked); needed for models whose faces hide each other (rooms, pillars).
-  bool scanline = true;
+  bool scanline = false;
 
   bool Check(std::string* why) const;
 };
@@ -41,8 +43,13 @@ struct TrackerSettings {
   // the previous one, sampling them every pass_step_factor * sample_step pixels. Three passes at
   // half density hold the pose on Castle-simu and on the end of mbt/cube, where one pass (ViSP's
   // own track()) drifts; they cost about 1.6x one ViSP track() (docs/tracking.md).
-  int passes = 3;
+  int passes = 2;
   double pass_step_factor = 2.0;
+  // Sub-pixel refinement of each tracked pose on the image edges (edge_refinement.h).
+  bool refine_subpixel = true;
+  EdgeRefinementOptions refinement;
+  // Alignment of a pose predicted from the robot's odometry before tracking (StartFromPrediction).
+  EdgeAlignmentOptions alignment;
   int max_iterations = 30;          // virtual visual servoing iterations per pass
   double good_edge_ratio = 0.4;     // ViSP gives up below this share of good moving edges
   std::string source = "defaults";  // the file the settings come from, for reports

@@ -22,6 +22,12 @@ struct TrackHealth {
   double position_sigma_m = 0.0;
   double rotation_sigma_deg = 0.0;
   int passes = 0;  // tracking passes run on the frame
+  // Sub-pixel refinement: whether it was applied, the edge points it found, and their RMS distance
+  // to the model edges before and after (pixels).
+  bool refined = false;
+  int refined_points = 0;
+  double refined_rms_before_px = 0.0;
+  double refined_rms_after_px = 0.0;
 
   double GoodShare() const {
     return edges_total > 0 ? static_cast<double>(edges_good) / edges_total : 0.0;
@@ -32,8 +38,8 @@ struct HealthThresholds {
   double max_projection_error_deg = 30.0;
   double min_good_share = 0.5;  // edges_good / edges_total
   int min_good_edges = 30;
-  double max_position_sigma_m = 0.05;
-  double max_rotation_sigma_deg = 2.0;
+  double max_position_sigma_m = 0.2;
+  double max_rotation_sigma_deg = 3.0;
 
   bool Check(std::string* why) const;
 };
