@@ -13,5 +13,6 @@ void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
+void AddReplay(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

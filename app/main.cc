@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
   app::AddBenchTrack(cli, &action);
+  app::AddReplay(cli, &action);
 
   try {
     cli.parse(argc, argv);
