@@ -52,7 +52,8 @@ class SynthCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+           (std::string("SynthCli.") +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

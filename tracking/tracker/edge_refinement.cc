@@ -210,24 +210,36 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
     }
     profile[k + half] = sum / 3.0;
   }
-  // |derivative| at k = -half + 1 .. half - 1; the maximum must lie within the search window.
-  int best = 0;
+  // Derivative at k = -half + 1 .. half - 1; its largest magnitude must lie within the window.
+  std::vector<double> derivative(profile.size(), 0.0);
+  int best = -1;
   double best_magnitude = -1.0;
-  std::vector<double> magnitude(profile.size(), 0.0);
   for (int k = 1; k + 1 < static_cast<int>(profile.size()); ++k) {
-    magnitude[k] = std::abs(profile[k + 1] - profile[k - 1]) / (2.0 * kSampleStep);
-    if (std::abs((k - half) * kSampleStep) <= search_px && magnitude[k] > best_magnitude) {
-      best_magnitude = magnitude[k];
+    derivative[k] = (profile[k + 1] - profile[k - 1]) / (2.0 * kSampleStep);
+    if (std::abs((k - half) * kSampleStep) <= search_px &&
+        std::abs(derivative[k]) > best_magnitude) {
+      best_magnitude = std::abs(derivative[k]);
       best = k;
     }
   }
-  if (best_magnitude < min_gradient || best <= 1 || best + 2 >= static_cast<int>(profile.size())) {
-    return nan;
+  if (best < 0 || best_magnitude < min_gradient) return nan;
+  // Centroid of the derivative over the step (same sign, above a quarter of the peak): unbiased
+  // for a step blurred symmetrically, and for the piecewise-linear profile of a sharp one.
+  const double sign = derivative[best] > 0.0 ? 1.0 : -1.0;
+  int lo = best, hi = best;
+  while (lo > 1 && sign * derivative[lo - 1] >= 0.25 * best_magnitude)
+    --lo;
+  while (hi + 2 < static_cast<int>(profile.size()) &&
+         sign * derivative[hi + 1] >= 0.25 * best_magnitude) {
+    ++hi;
   }
-  const double a = magnitude[best - 1], b = magnitude[best], c = magnitude[best + 1];
-  const double curvature = a - 2.0 * b + c;
-  const double shift = curvature < 0.0 ? 0.5 * (a - c) / curvature : 0.0;
-  return (best - half + shift) * kSampleStep;
+  if (lo <= 1 || hi + 2 >= static_cast<int>(profile.size())) return nan;  // step cut by the window
+  double weight = 0.0, moment = 0.0;
+  for (int k = lo; k <= hi; ++k) {
+    weight += sign * derivative[k];
+    moment += sign * derivative[k] * (k - half);
+  }
+  return moment / weight * kSampleStep;
 }
 
 EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,

@@ -33,9 +33,9 @@ struct EdgeRefinementOptions {
 
 // Sub-pixel offset (pixels along the unit `normal`) of the strongest intensity step within
 // +-search_px of `point`: central differences of bilinear samples every half pixel, averaged over
-// three parallel lines one pixel apart, and a parabola through the largest magnitude and its
-// neighbours. NaN when the strongest step is weaker than min_gradient (grey levels per pixel) or
-// lies on the window's end.
+// three parallel lines one pixel apart; the offset is the centroid of the derivative over the
+// step around its peak. NaN when the strongest step is weaker than min_gradient (grey levels per
+// pixel) or is cut by the window's end.
 double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vector2d& point,
                           const Eigen::Vector2d& normal, double search_px, double min_gradient);
 
