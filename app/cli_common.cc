@@ -31,6 +31,26 @@ Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
   return {values[0], values[1], DegToRad(values[2])};
 }
 
+std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag) {
+  std::stringstream in(text);
+  std::string field;
+  std::vector<double> values;
+  while (std::getline(in, field, ',')) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(field, &used));
+      if (used != field.size() || !std::isfinite(values.back())) throw std::invalid_argument(field);
+    } catch (const std::exception&) {
+      throw InputError(flag + ": not a finite number: '" + field + "' in '" + text + "'");
+    }
+  }
+  if (static_cast<int>(values.size()) != count || (!text.empty() && text.back() == ',')) {
+    throw InputError(flag + ": expected " + std::to_string(count) +
+                     " comma-separated numbers, got '" + text + "'");
+  }
+  return values;
+}
+
 void CheckRange(double value, double lo, double hi, const std::string& flag) {
   if (!std::isfinite(value) || value < lo || value > hi) {
     std::ostringstream msg;

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "models/robot_pose.h"
 
@@ -21,6 +22,9 @@ using CommandAction = std::function<int()>;
 // Parses "X,Y,HEADING_DEG" (metres, metres, degrees) into a Pose3Dof with heading in radians.
 // Throws InputError naming `flag` when malformed or not finite.
 Pose3Dof ParsePrior(const std::string& text, const std::string& flag);
+
+// Parses `count` comma-separated finite numbers; throws InputError naming `flag` otherwise.
+std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag);
 
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
 void CheckRange(double value, double lo, double hi, const std::string& flag);

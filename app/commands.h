@@ -12,6 +12,11 @@ void AddRender(CLI::App& cli, CommandAction* action);
 void AddBenchCapture(CLI::App& cli, CommandAction* action);
 void AddBenchMatch(CLI::App& cli, CommandAction* action);
 void AddSynth(CLI::App& cli, CommandAction* action);
+void AddCalibrate(CLI::App& cli, CommandAction* action);
+void AddBenchCalibrate(CLI::App& cli, CommandAction* action);
+void AddBenchLines(CLI::App& cli, CommandAction* action);
+void AddLines(CLI::App& cli, CommandAction* action);
+void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
 void AddReplay(CLI::App& cli, CommandAction* action);
 

@@ -49,6 +49,11 @@ int main(int argc, char** argv) {
   app::AddBenchCapture(cli, &action);
   app::AddBenchMatch(cli, &action);
   app::AddSynth(cli, &action);
+  app::AddCalibrate(cli, &action);
+  app::AddBenchCalibrate(cli, &action);
+  app::AddBenchLines(cli, &action);
+  app::AddLines(cli, &action);
+  app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
   app::AddReplay(cli, &action);
 

@@ -23,6 +23,7 @@ function(linetrack_add_test)
   cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK;PROPERTIES" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
+  target_include_directories(${ARG_NAME} PRIVATE ${LINETRACK_SOURCE_DIR})  # tests/support/
   target_compile_definitions(${ARG_NAME} PRIVATE
     LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
     LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")

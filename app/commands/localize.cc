@@ -10,6 +10,8 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/image_overlay.h"
+#include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "models/errors.h"
 
@@ -21,10 +23,26 @@ struct LocalizeOptions {
   double delta_t = 0.0, delta_phi_deg = 0.0, height = 0.0, tilt_deg = 0.0;
   std::string method = "tree";
   bool json = false;
+  // From an image (--image) instead of --lines: the line extractor's flags and an overlay.
+  std::string image_path, overlay_path;
+  LineFlags lines;
+  // Matcher noise: "PX,DEG" (default: the paper's for --lines, the extractor's for --image) and
+  // the relative focal-length error of the camera file (default the paper's 2 %).
+  std::string line_noise;
+  double focal_error = LineNoise().focal_relative;
 };
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
+  if (!opt.image_path.empty()) options = DetectedLineMatcherOptions(options);
+  if (!opt.line_noise.empty()) {
+    const std::vector<double> v = ParseNumbers(opt.line_noise, 2, "--line-noise");
+    options.noise.offset_px = v[0];
+    options.noise.angle_deg = v[1];
+  }
+  options.noise.focal_relative = opt.focal_error;
+  std::string why;
+  if (!options.noise.Check(&why)) throw InputError("--line-noise/--focal-error: " + why);
   if (opt.method == "baseline") options.method = MatchMethod::kHypothesizeAndTest;
   return options;
 }
@@ -88,21 +106,47 @@ int RunSingle(const LocalizeOptions& opt) {
   problem.delta_phi = DegToRad(opt.delta_phi_deg);
   problem.height = opt.height;
   problem.tilt = DegToRad(opt.tilt_deg);
-  problem.lines = ReadLinesCsv(opt.lines_path);
+  const std::string& source = opt.image_path.empty() ? opt.lines_path : opt.image_path;
+  std::optional<ImageLines> image;
+  if (!opt.image_path.empty()) {
+    if (!opt.overlay_path.empty()) CheckPngOutput(opt.overlay_path, "--overlay");
+    image = ExtractImageLines(opt.image_path, opt.camera_path, opt.camera_name, opt.lines);
+    problem.lines = image->segments;
+  } else {
+    problem.lines = ReadLinesCsv(opt.lines_path);
+  }
   try {
-    CheckProblem(problem);
+    if (!problem.lines.empty()) CheckProblem(problem);
   } catch (const InputError& e) {
-    throw InputError(opt.lines_path + ": " + e.what());
+    throw InputError(source + ": " + e.what());
   }
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
   const auto start = std::chrono::steady_clock::now();
-  const LocalizationResult result = localizer.Localize(problem);
+  LocalizationResult result;
+  if (problem.lines.empty()) {
+    result.reason = "no line segments in the image";  // an image may show none: not bad input
+  } else {
+    result = localizer.Localize(problem);
+  }
   const double ms = Milliseconds(start);
+  if (image && !opt.overlay_path.empty()) {
+    WriteFileAtomically(
+        opt.overlay_path,
+        LocalizationOverlayPng(*image, *cache.Model(opt.model_path).model, result, ms));
+  }
+  if (image && !opt.json) {
+    std::cout << "lines     " << image->segments.size() << " segments (" << image->detector << ", "
+              << std::fixed << std::setprecision(2) << image->ms << " ms)\n";
+  }
   if (opt.json) {
-    std::cout
-        << ResultToJson(std::filesystem::path(opt.lines_path).stem().string(), result, ms).dump(2)
-        << std::endl;
+    nlohmann::ordered_json json =
+        ResultToJson(std::filesystem::path(source).stem().string(), result, ms);
+    if (image) {
+      json["lines"] = image->segments.size();
+      json["lines_ms"] = image->ms;
+    }
+    std::cout << json.dump(2) << std::endl;
   } else if (result.found) {
     std::cout << std::fixed << std::setprecision(3) << "pose      x " << result.pose.x << " m, y "
               << result.pose.y << " m, heading " << std::setprecision(2)
@@ -132,6 +176,18 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--camera", opt->camera_path, "ViSP camera XML (undistorted pixels)");
   cmd->add_option("--camera-name", opt->camera_name, "Camera name in the XML (default: first)");
   cmd->add_option("--lines", opt->lines_path, "CSV of segments u1,v1,u2,v2 in pixels");
+  cmd->add_option("--image", opt->image_path,
+                  "Image to extract the segments from instead of --lines (see linetrack lines)");
+  cmd->add_option("--overlay", opt->overlay_path,
+                  "With --image: PNG of the matched model edges (green), unmatched lines (red)");
+  AddLineFlags(cmd, &opt->lines, false);
+  cmd->add_option("--line-noise", opt->line_noise,
+                  "Line noise OFFSET_PX,ANGLE_DEG for the matcher's margins (default 3,1 as in "
+                  "the paper; with --image 1,0.3 and a 2.5 px / 2 deg match distance, "
+                  "docs/lines.md)");
+  cmd->add_option("--focal-error", opt->focal_error,
+                  "Relative focal-length uncertainty of the camera file")
+      ->capture_default_str();
   cmd->add_option("--prior", opt->prior_text, "Prior pose X,Y,HEADING_DEG (metres, degrees)");
   cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)");
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
@@ -147,11 +203,17 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       *action = [opt] { return RunBatch(*opt); };
       return;
     }
-    for (const char* flag : {"--model", "--camera", "--lines", "--prior", "--delta-t",
-                             "--delta-phi", "--height", "--tilt"}) {
+    for (const char* flag :
+         {"--model", "--camera", "--prior", "--delta-t", "--delta-phi", "--height", "--tilt"}) {
       if (cmd->count(flag) == 0) {
         throw CLI::RequiredError(std::string(flag) + " is required without --batch");
       }
+    }
+    if (cmd->count("--lines") + cmd->count("--image") != 1) {
+      throw CLI::RequiredError("give one of --lines and --image (without --batch)");
+    }
+    if (cmd->count("--overlay") > 0 && cmd->count("--image") == 0) {
+      throw CLI::ValidationError("--overlay", "draws over an --image");
     }
     *action = [opt] { return RunSingle(*opt); };
   });

@@ -15,12 +15,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/line_flags.h"
+#include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "app/replay_output.h"
 #include "models/errors.h"
 #include "models/occlusion.h"
 #include "tracking/capture/video_source.h"
-#include "tracking/tracker/fld_line_extractor.h"
 #include "tracking/tracker/pose_file.h"
 #include "tracking/tracker/robot_readings.h"
 
@@ -37,6 +38,7 @@ struct ReplayOptions {
   double fps = 0.0;
   long max_frames = 0;
   bool overlay_png = false, no_overlay = false, scanline = false;
+  LineFlags lines;  // the line extractor of the re-localisation
 };
 
 std::atomic<int> g_signal{0};
@@ -239,10 +241,12 @@ int RunReplay(const ReplayOptions& opt) {
   std::unique_ptr<Relocalizer> relocalizer;
   if (s.robot) {
     localizer = std::make_unique<Localizer>(*loaded.model, loaded.regions.get(), loaded.area.get(),
-                                            s.camera);
+                                            s.camera, DetectedLineMatcherOptions({}));
     RelocalizationOptions relocalization;
     relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
-    relocalizer = std::make_unique<Relocalizer>(*localizer, MakeFldLineExtractor(), relocalization);
+    // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
+    relocalizer = std::make_unique<Relocalizer>(
+        *localizer, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
   }
   SequenceTracker sequence(&tracker, s.camera, relocalizer.get(), SequenceTrackerOptions());
   if (s.start_pose) sequence.SetStartPose(*s.start_pose);
@@ -415,6 +419,7 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--frames", opt->max_frames, "Stop after this many frames (0: all)");
   cmd->add_flag("--overlay-png", opt->overlay_png, "Overlay as DIR/overlay/frame_%05d.png");
   cmd->add_flag("--no-overlay", opt->no_overlay, "No overlay");
+  AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   cmd->add_flag("--scanline", opt->scanline,
                 "Scan-line visibility (hidden edge parts not tracked; about 4x slower)");
   cmd->callback([opt, action] { *action = [opt] { return RunReplay(*opt); }; });

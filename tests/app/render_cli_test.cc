@@ -11,6 +11,7 @@
 
 #include "models/render/scene_renderer.h"
 #include "models/trajectory_io.h"
+#include "tests/support/cli_test.h"
 
 namespace linetrack {
 namespace {
@@ -22,45 +23,17 @@ const std::string kModel = kSource + "/models/hall.cao";
 const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
 const std::string kNav = kSource + "/tests/data/hall.nav.json";
 
-struct CommandRun {
-  int code = -1;
-  std::string err;
-};
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-class RenderCli : public ::testing::Test {
+class RenderCli : public test_support::CliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+  // Runs `linetrack render` on the hall with the paper's camera and ARGS.
+  test_support::CommandRun Render(const std::string& args) const {
+    return Linetrack("render --model " + kModel + " --camera " + kCamera + " " + args);
   }
-
-  CommandRun Linetrack(const std::string& args) {
-    const std::string err = (dir_ / "stderr.txt").string();
-    const std::string cmd = std::string(LINETRACK_EXE) + " render --model " + kModel +
-                            " --camera " + kCamera + " " + args + " > /dev/null 2> " + err;
-    const int status = std::system(cmd.c_str());
-    CommandRun run;
-    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.err = ReadAll(err);
-    fs::remove(err);
-    return run;
-  }
-
-  fs::path dir_;
 };
 
 TEST_F(RenderCli, OneViewIsTheLibrarysImage) {
   const std::string out = (dir_ / "view.png").string();
-  ASSERT_EQ(Linetrack("--pose 2,2,30 --height 1.3 --tilt 5 --seed 4 --out " + out).code, 0);
+  ASSERT_EQ(Render("--pose 2,2,30 --height 1.3 --tilt 5 --seed 4 --out " + out).code, 0);
   vpImage<unsigned char> written;
   vpImageIo::read(written, out);
   RenderOptions options;
@@ -81,7 +54,7 @@ TEST_F(RenderCli, SequenceFromATrajectoryWritesEverything) {
   const std::string tum = (dir_ / "in.txt").string();
   std::ofstream(tum) << FormatTum(poses);
   const fs::path out = dir_ / "seq";
-  const CommandRun run = Linetrack("--trajectory " + tum + " --out " + out.string());
+  const test_support::CommandRun run = Render("--trajectory " + tum + " --out " + out.string());
   ASSERT_EQ(run.code, 0) << run.err;
   for (const char* name : {"frame_00000.png", "frame_00001.png", "frame_00002.png",
                            "groundtruth.txt", "priors.csv", "camera.xml"}) {
@@ -103,9 +76,9 @@ TEST_F(RenderCli, SequenceFromATrajectoryWritesEverything) {
 
 TEST_F(RenderCli, HallLoopWithPanTilt) {
   const fs::path out = dir_ / "loop";
-  const CommandRun run =
-      Linetrack("--path hall-loop --nav " + kNav +
-                " --frames 2 --pan-amplitude 20 --clutter 5 --out " + out.string());
+  const test_support::CommandRun run =
+      Render("--path hall-loop --nav " + kNav +
+             " --frames 2 --pan-amplitude 20 --clutter 5 --out " + out.string());
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_TRUE(fs::exists(out / "frame_00001.png"));
   EXPECT_EQ(ReadPriors((out / "priors.csv").string()).size(), 2u);
@@ -129,7 +102,7 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {"--trajectory /nonexistent.txt --out " + seq, "/nonexistent.txt"},
   };
   for (const auto& [args, what] : cases) {
-    const CommandRun run = Linetrack(args);
+    const test_support::CommandRun run = Render(args);
     EXPECT_EQ(run.code, 2) << args;
     EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;

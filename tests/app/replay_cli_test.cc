@@ -10,27 +10,19 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/support/cli_test.h"
+
 namespace linetrack {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::CommandRun;
+using test_support::ReadAll;
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 constexpr double kCastleMaxAteM = 0.005;
 constexpr double kHallMaxAteM = 0.02;
 constexpr int kMaxInitialisingFrames = 3;
-
-struct CommandRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 int CountLines(const fs::path& path) {
   std::ifstream in(path);
@@ -46,28 +38,11 @@ std::string VispImages() {
   return std::string(env ? env : "/usr/share/visp-images-data") + "/ViSP-images";
 }
 
-class ReplayCli : public ::testing::Test {
+class ReplayCli : public test_support::CliTest {
  protected:
   void SetUp() override {
-    // The suite in the name: other CLI tests have tests of the same name and run in parallel.
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           (std::string("ReplayCli.") +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliTest::SetUp();
     castle_ = VispImages() + "/mbt-depth/Castle-simu";
-  }
-
-  CommandRun Linetrack(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd =
-        std::string(LINETRACK_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
-    const int status = std::system(cmd.c_str());
-    CommandRun run;
-    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = ReadAll(out);
-    run.err = ReadAll(err);
-    return run;
   }
 
   std::string CastleArgs(const std::string& input, const fs::path& out) const {
@@ -77,7 +52,6 @@ class ReplayCli : public ::testing::Test {
            castle_ + "/CameraPose/Camera_001.txt --out " + out.string();
   }
 
-  fs::path dir_;
   std::string castle_;
 };
 

@@ -1,6 +1,6 @@
 // Image-level parts of the tracker, from known ground truth: undistortion of a rendered distorted
 // view, the sub-pixel edge locator on steps at known positions, the pose refinement on the edges
-// of a rendered hall view from a perturbed start, and the interim line extractor.
+// of a rendered hall view from a perturbed start, the alignment of a prediction.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +11,6 @@
 #include "models/occlusion.h"
 #include "models/render/scene_renderer.h"
 #include "tracking/tracker/edge_refinement.h"
-#include "tracking/tracker/fld_line_extractor.h"
 #include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -158,20 +157,6 @@ TEST(EdgeRefinement, AlignsAPredictionSeveralPixelsOff) {
   ASSERT_TRUE(aligned.applied);
   EXPECT_LT(ComparePoses(aligned.cam_from_world, truth).translation, kRefinedPositionTolM);
   EXPECT_LT(RadToDeg(ComparePoses(aligned.cam_from_world, truth).rotation), kRefinedRotationTolDeg);
-}
-
-TEST(FldLineExtractor, FindsTheHallsLongEdges) {
-  const HallView hall;
-  const std::vector<Segment2> lines = MakeFldLineExtractor()(hall.Render(false));
-  int long_lines = 0;
-  for (const Segment2& s : lines) {
-    EXPECT_GE(s.Length(), FldExtractorOptions().min_length_px - 1.0);
-    long_lines += s.Length() > 100.0 ? 1 : 0;
-  }
-  EXPECT_GE(long_lines, 5);
-  FldExtractorOptions bad;
-  bad.min_length_px = 0.0;
-  EXPECT_THROW(MakeFldLineExtractor(bad), InputError);
 }
 
 }  // namespace

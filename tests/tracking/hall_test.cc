@@ -7,11 +7,11 @@
 
 #include <memory>
 
+#include "matching/lines/line_extractor.h"
 #include "models/navigable_area.h"
 #include "models/render/scene_renderer.h"
 #include "models/render/sequence.h"
 #include "models/view_invariant_regions.h"
-#include "tracking/tracker/fld_line_extractor.h"
 #include "tracking/tracker/sequence_tracker.h"
 
 namespace linetrack {
@@ -81,8 +81,13 @@ TrackedRun TrackHall(Hide hide) {
   const HallData& hall = Hall();
   const NavigableArea area = NavigableArea::FromModel(hall.model);
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(hall.model, area);
-  const Localizer localizer(hall.model, &regions, &area, hall.camera);
-  const Relocalizer relocalizer(localizer, MakeFldLineExtractor());
+  // The matcher set for detected lines, as `linetrack localize --image` and `replay` use it.
+  LocalizerOptions matcher;
+  matcher.noise = DetectedLineNoise();
+  matcher.verification.match_distance_px = 2.5;
+  matcher.verification.match_angle_deg = 2.0;
+  const Localizer localizer(hall.model, &regions, &area, hall.camera, matcher);
+  const Relocalizer relocalizer(localizer, MakeLineExtractorFunction(LineExtractionOptions()));
   EdgeTracker tracker(kSource + "/models/hall.cao", hall.camera, TrackerSettings());
   SequenceTracker sequence(&tracker, hall.camera, &relocalizer, {});
   const RobotPose& truth = hall.frames[0].camera;

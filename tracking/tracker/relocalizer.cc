@@ -62,7 +62,7 @@ RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
   return prior;
 }
 
-Relocalizer::Relocalizer(const Localizer& localizer, LineExtractor extractor,
+Relocalizer::Relocalizer(const Localizer& localizer, LineExtractorFunction extractor,
                          const RelocalizationOptions& options)
     : localizer_(localizer), extractor_(std::move(extractor)), options_(options) {
   std::string why;

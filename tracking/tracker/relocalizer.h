@@ -5,20 +5,16 @@
 
 #include <visp3/core/vpImage.h>
 
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "matching/lines/line_extractor.h"
 #include "matching/localizer.h"
 #include "models/geometry.h"
 #include "models/robot_pose.h"
 
 namespace linetrack {
-
-// Line segments (pixels of the undistorted image) of an undistorted grey image. Injected by the
-// caller (the detector of matching/lines, or any other).
-using LineExtractor = std::function<std::vector<Segment2>(const vpImage<unsigned char>&)>;
 
 // Prior position and heading bounds of the matcher (metres, radians).
 struct SearchBounds {
@@ -59,8 +55,9 @@ struct RelocalizationAttempt {
 
 class Relocalizer {
  public:
-  // The localizer must outlive the relocalizer.
-  Relocalizer(const Localizer& localizer, LineExtractor extractor,
+  // The localizer must outlive the relocalizer. `extractor` gives the segments of an undistorted
+  // grey image in its pixels (injected: matching/lines' LineExtractor, or any other).
+  Relocalizer(const Localizer& localizer, LineExtractorFunction extractor,
               const RelocalizationOptions& options = {});
 
   // Extracts lines from `undistorted` and runs the matcher around `prior` (its height and tilt
@@ -72,7 +69,7 @@ class Relocalizer {
 
  private:
   const Localizer& localizer_;
-  LineExtractor extractor_;
+  LineExtractorFunction extractor_;
   RelocalizationOptions options_;
 };
 

@@ -1,0 +1,172 @@
+// `linetrack lines` and `linetrack localize --image` end to end on rendered hall views: the CSV
+// is the library's answer and parses back as localize --lines reads it, the localisation from
+// images lands on the true pose, and unreadable or empty images exit 2 with one line and write
+// nothing.
+#include <gtest/gtest.h>
+
+#include <visp3/io/vpImageIo.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/localize_io.h"
+#include "matching/lines/line_extractor.h"
+#include "models/render/scene_renderer.h"
+#include "models/robot_pose.h"
+#include "tests/support/cli_test.h"
+
+namespace linetrack {
+namespace {
+
+using test_support::CommandRun;
+using test_support::ReadAll;
+
+namespace fs = std::filesystem;
+
+const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kModel = kSource + "/models/hall.cao";
+const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
+const std::string kWideCamera = kSource + "/tests/data/camera_wide.xml";
+
+constexpr double kCsvTolPx = 1e-3;  // the CSV keeps three decimals
+// End to end from rendered images (generous: the matcher is not under test here).
+constexpr double kPositionTolM = 0.2;
+constexpr double kHeadingTolDeg = 3.0;
+
+int Lines(const std::string& text) {
+  int n = 0;
+  for (char c : text)
+    n += c == '\n' ? 1 : 0;
+  return n;
+}
+
+class LinesCli : public test_support::CliTest {
+ protected:
+  // Renders the hall from `pose` with `camera_file` into DIR/name (10 clutter objects).
+  std::string RenderView(const RobotPose& pose, const std::string& name,
+                         const std::string& camera_file = kCamera) {
+    const WireframeModel model = WireframeModel::Load(kModel);
+    const NavigableArea area = NavigableArea::FromModel(model);
+    RenderOptions options;
+    options.scene.clutter = 10;
+    SceneRenderer renderer(model, ReadCameraXml(camera_file), options, &area);
+    vpImage<unsigned char> image = renderer.Render(CamFromWorld(pose));
+    const std::string path = (dir_ / name).string();
+    vpImageIo::write(image, path);
+    return path;
+  }
+
+  std::vector<std::string> Files() const {
+    std::vector<std::string> files;
+    for (const auto& entry : fs::directory_iterator(dir_))
+      files.push_back(entry.path().filename().string());
+    std::sort(files.begin(), files.end());
+    return files;
+  }
+};
+
+TEST_F(LinesCli, CsvIsTheLibrarysSegmentsAndReadsBack) {
+  for (const std::string& camera : {kCamera, kWideCamera}) {
+    SCOPED_TRACE(camera);
+    const std::string image =
+        RenderView({2.0, 2.0, DegToRad(30.0), 1.3, DegToRad(5.0)}, "view.png", camera);
+    const std::string csv = (dir_ / "lines.csv").string();
+    const std::string overlay = (dir_ / "overlay.png").string();
+    const CommandRun run = Linetrack("lines " + image + " --camera " + camera + " --out " + csv +
+                                     " --overlay " + overlay);
+    ASSERT_EQ(run.code, 0) << run.err;
+    EXPECT_EQ(ReadAll(csv).substr(0, 12), "u1,v1,u2,v2\n");
+    const std::vector<Segment2> written = app::ReadLinesCsv(csv);
+    vpImage<unsigned char> grey;
+    vpImageIo::read(grey, image);
+    LineExtractor extractor(LineExtractionOptions(), ReadCameraXml(camera));
+    const std::vector<Segment2> expected = extractor(grey);
+    ASSERT_EQ(written.size(), expected.size());
+    ASSERT_GT(written.size(), 10u);
+    for (size_t i = 0; i < written.size(); ++i) {
+      EXPECT_NEAR((written[i].a - expected[i].a).norm(), 0.0, kCsvTolPx);
+      EXPECT_NEAR((written[i].b - expected[i].b).norm(), 0.0, kCsvTolPx);
+    }
+    vpImage<vpRGBa> picture;
+    vpImageIo::read(picture, overlay);
+    EXPECT_EQ(picture.getWidth(), 640u);
+    EXPECT_EQ(picture.getHeight(), 480u);
+  }
+}
+
+TEST_F(LinesCli, LocalizesRenderedViewsFromTheirImages) {
+  // Views of the hall and priors within QI3 of them (0.75 m, 20 deg).
+  struct Case {
+    RobotPose truth;
+    double dx, dy, dh_deg;
+  };
+  const Case cases[] = {
+      {{2.0, 2.0, DegToRad(30.0), 1.3, DegToRad(5.0)}, 0.4, -0.3, 12.0},
+      {{7.0, 2.0, DegToRad(150.0), 1.4, DegToRad(3.0)}, -0.5, 0.2, -15.0},
+      {{11.5, 1.5, DegToRad(120.0), 1.35, DegToRad(8.0)}, 0.3, 0.5, 8.0},
+      {{3.0, 7.0, DegToRad(-60.0), 1.5, DegToRad(0.0)}, -0.2, -0.6, -18.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE("view at " + std::to_string(c.truth.x) + ", " + std::to_string(c.truth.y));
+    const std::string image = RenderView(c.truth, "view.png");
+    const std::string overlay = (dir_ / "localized.png").string();
+    std::ostringstream args;
+    args << "localize --json --model " << kModel << " --camera " << kCamera << " --image " << image
+         << " --overlay " << overlay << " --prior " << c.truth.x + c.dx << "," << c.truth.y + c.dy
+         << "," << RadToDeg(c.truth.heading) + c.dh_deg
+         << " --delta-t 0.75 --delta-phi 20 --height " << c.truth.height << " --tilt "
+         << RadToDeg(c.truth.tilt) << " --focal-error 0.005";
+    const CommandRun run = Linetrack(args.str());
+    ASSERT_EQ(run.code, 0) << run.out << run.err;
+    const nlohmann::json result = nlohmann::json::parse(run.out);
+    ASSERT_TRUE(result["found"].get<bool>());
+    EXPECT_NEAR(result["pose"]["x"].get<double>(), c.truth.x, kPositionTolM);
+    EXPECT_NEAR(result["pose"]["y"].get<double>(), c.truth.y, kPositionTolM);
+    EXPECT_NEAR(RadToDeg(WrapAngle(DegToRad(result["pose"]["heading_deg"].get<double>()) -
+                                   c.truth.heading)),
+                0.0, kHeadingTolDeg);
+    EXPECT_GT(result["lines"].get<int>(), 5);
+    EXPECT_TRUE(fs::is_regular_file(overlay));
+  }
+}
+
+TEST_F(LinesCli, UnreadableOrEmptyImagesExit2WithOneLineAndNoOutput) {
+  const std::string empty = (dir_ / "empty.png").string();
+  std::ofstream(empty).close();
+  const std::string garbage = (dir_ / "garbage.png").string();
+  std::ofstream(garbage) << "not an image\n";
+  const std::string small = RenderView({2.0, 2.0, DegToRad(30.0), 1.3, 0.0}, "small.pgm");
+  {
+    // A 320x240 image for a 640x480 camera.
+    vpImage<unsigned char> half(240, 320, 128);
+    vpImageIo::write(half, small);
+  }
+  const std::string csv = (dir_ / "out.csv").string(), png = (dir_ / "out.png").string();
+  const std::vector<std::string> before = Files();
+  const std::string localize = "localize --model " + kModel + " --camera " + kCamera +
+                               " --prior 2,2,30 --delta-t 0.75 --delta-phi 20 --height 1.3 "
+                               "--tilt 5 --overlay " +
+                               png + " --image ";
+  for (const std::string& args :
+       {"lines " + (dir_ / "missing.png").string() + " --out " + csv + " --overlay " + png,
+        "lines " + empty + " --out " + csv + " --overlay " + png,
+        "lines " + garbage + " --out " + csv + " --overlay " + png,
+        "lines " + small + " --camera " + kCamera + " --out " + csv + " --overlay " + png,
+        "lines " + garbage + " --out " + csv + " --overlay " + (dir_ / "o.jpg").string(),
+        "lines " + empty + " --out " + (dir_ / "no/such/dir.csv").string(), localize + empty,
+        localize + garbage, localize + small}) {
+    SCOPED_TRACE(args);
+    const CommandRun run = Linetrack(args);
+    EXPECT_EQ(run.code, 2);
+    EXPECT_EQ(Lines(run.err), 1) << run.err;
+    EXPECT_EQ(Files(), before);
+  }
+  // The message names the file at fault.
+  EXPECT_NE(Linetrack("lines " + garbage + " --out " + csv).err.find(garbage), std::string::npos);
+  EXPECT_NE(Linetrack("lines " + empty + " --out " + csv).err.find(empty), std::string::npos);
+}
+
+}  // namespace
+}  // namespace linetrack
