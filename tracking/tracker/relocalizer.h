@@ -19,16 +19,19 @@ namespace linetrack {
 // Prior position and heading bounds of the matcher (metres, radians).
 struct SearchBounds {
   double delta_t = 0.75;
-  double delta_phi = 0.349;  // 20 degrees: the paper's QI3
+  double delta_phi = 0.3490658503988659;  // 20 degrees: the paper's QI3
 };
 
 struct RelocalizationOptions {
-  SearchBounds initial;                 // first localisation, and a prior read from the file as is
-  SearchBounds after_loss{0.3, 0.175};  // prior carried from the last good pose, at the loss
-  double growth_t = 0.05;               // metres added per frame since the last good pose
-  double growth_phi = 0.0175;           // radians added per frame (1 degree)
-  SearchBounds max{1.5, 0.785};         // widest bounds (45 degrees)
-  int min_lines = 4;                    // fewer extracted lines: no attempt
+  // First localisation, and a prior read from the file as it is.
+  SearchBounds initial;
+  // A prior carried from the last good pose, at the loss: 0.3 m, 10 degrees.
+  SearchBounds after_loss{0.3, 0.17453292519943295};
+  double growth_t = 0.05;      // metres added per frame since the last good pose
+  double growth_phi = 0.0175;  // radians added per frame (1 degree)
+  // The widest bounds: 1.5 m, 45 degrees.
+  SearchBounds max{1.5, 0.7853981633974483};
+  int min_lines = 4;  // fewer extracted lines: no attempt
 
   bool Check(std::string* why) const;
 };
