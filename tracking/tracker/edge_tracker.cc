@@ -95,6 +95,9 @@ EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& 
     : tracker_(std::make_unique<vpMbGenericTracker>(1, vpMbGenericTracker::EDGE_TRACKER)),
       camera_(camera.Undistorted()),
       settings_(settings) {
+  if (camera_.width <= 0 || camera_.height <= 0) {
+    throw InputError("camera '" + camera_.name + "': the image size is needed to track");
+  }
   LoadVispModel(model_path, tracker_.get());
   model_ = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
   occlusion_ = std::make_unique<OcclusionTester>(*model_);
@@ -209,26 +212,6 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
     health.rotation_sigma_deg = vpMath::deg(sigmas.y());
   }
   return result;
-}
-
-std::vector<Segment2> EdgeTracker::ProjectModel(const Eigen::Isometry3d& cam_from_world) {
-  std::vector<Segment2> segments;
-  vpCameraParameters cam;
-  cam.initPersProjWithoutDistortion(camera_.px, camera_.py, camera_.u0, camera_.v0);
-  try {
-    const std::vector<std::vector<double>> model = tracker_->getModelForDisplay(
-        static_cast<unsigned>(camera_.width), static_cast<unsigned>(camera_.height),
-        ToVispPose(cam_from_world), cam);
-    for (const std::vector<double>& line : model) {
-      // Lines are {0, i1, j1, i2, j2} (row, column); other primitives are skipped.
-      if (line.size() < 5 || line[0] != 0.0) continue;
-      segments.push_back(
-          Segment2{Eigen::Vector2d(line[2], line[1]), Eigen::Vector2d(line[4], line[3])});
-    }
-  } catch (const vpException&) {
-    segments.clear();
-  }
-  return segments;
 }
 
 }  // namespace linetrack

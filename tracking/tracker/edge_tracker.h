@@ -36,9 +36,9 @@ struct EdgeTrackResult {
 class EdgeTracker {
  public:
   // Loads the .cao model through ViSP (and linetrack's reader, for the edges the sub-pixel
-  // refinement uses) and applies `settings` and the (undistorted) camera. Throws InputError
-  // naming the model when it cannot be loaded, or naming the settings' source when they are
-  // invalid.
+  // refinement uses) and applies `settings` and the (undistorted) camera, whose image size must
+  // be known. Throws InputError naming the model when it cannot be loaded, or naming the settings'
+  // source when they are invalid.
   EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
               const TrackerSettings& settings);
   ~EdgeTracker();
@@ -66,10 +66,6 @@ class EdgeTracker {
 
   // True after a successful Start() and until a Track() fails.
   bool started() const { return started_; }
-
-  // The visible parts of the model edges projected with `cam_from_world` (pixels of the
-  // undistorted image, clipped to it), as ViSP's visibility settings see them.
-  std::vector<Segment2> ProjectModel(const Eigen::Isometry3d& cam_from_world);
 
   const TrackerSettings& settings() const { return settings_; }
   const CameraIntrinsics& camera() const { return camera_; }
