@@ -10,6 +10,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/trajectory_io.h"
+#include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
 
@@ -19,14 +20,6 @@ std::string Fixed(double value, int decimals) {
   char text[64];
   std::snprintf(text, sizeof(text), "%.*f", decimals, value);
   return text;
-}
-
-// The q-quantile (nearest rank) of `values`; 0 for none.
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
 }
 
 nlohmann::ordered_json Percentiles(const std::vector<double>& values) {

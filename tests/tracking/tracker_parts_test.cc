@@ -186,8 +186,8 @@ TEST(Relocalization, OdometryPredictionKeepsTheLastPoseRelation) {
       (PredictFromOdometry(CamFromWorld(then), then, now).matrix() - CamFromWorld(now).matrix())
           .norm(),
       1e-12);
-  // A last pose off by a world offset: the prediction carries the same offset... in the camera
-  // frame of `then`, i.e. C_pred C_now^-1 == C_last C_then^-1.
+  // A last pose away from the odometry's: the prediction moves it by the odometry's motion in
+  // the camera frame, C_now^-1 C_pred == C_then^-1 C_last.
   const Eigen::Isometry3d last = CamFromWorld(RobotPose{1.1, 2.05, 0.42, 1.32, 0.07});
   const Eigen::Isometry3d predicted = PredictFromOdometry(last, then, now);
   EXPECT_LT(((CamFromWorld(now).inverse() * predicted).matrix() -
