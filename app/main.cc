@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
   app::AddBenchLines(cli, &action);
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
+  app::AddBenchTrack(cli, &action);
+  app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
 

@@ -14,3 +14,7 @@ build/app/linetrack bench match --count 100 --series qi1 qi3 --no-baseline --out
 build/app/linetrack render --model models/hall.cao --camera tests/data/camera_paper.xml --pose 2.0,2.0,30 --height 1.3 --tilt 5 --clutter 10 --out out/demo/view.png
 build/app/linetrack lines out/demo/view.png --camera tests/data/camera_paper.xml --out out/demo/view_lines.csv
 build/app/linetrack localize --model models/hall.cao --camera tests/data/camera_paper.xml --image out/demo/view.png --prior 2.4,1.7,40 --delta-t 0.75 --delta-phi 20 --height 1.3 --tilt 5 --focal-error 0.005 --overlay out/demo/localize_image.png
+# Tracking: a rendered drive through the hall (odometry priors that drift), replayed from them:
+# the matcher finds the first pose, the moving edges follow, losses are recovered.
+build/app/linetrack render --model models/hall.cao --camera tests/data/camera_wide.xml --path hall-loop --nav tests/data/hall.nav.json --frames 120 --clutter 10 --out out/demo/drive
+build/app/linetrack replay --input 'out/demo/drive/frame_%05d.png' --model models/hall.cao --camera out/demo/drive/camera.xml --prior-file out/demo/drive/priors.csv --ground-truth out/demo/drive/groundtruth.txt --out out/demo/replay

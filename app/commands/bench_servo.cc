@@ -11,6 +11,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "tracking/live/servo_bench.h"
+#include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
 namespace {
@@ -33,11 +34,11 @@ nlohmann::ordered_json ToJson(const ServoBenchRun& r) {
           {"mean_error_px", r.mean_error_px},
           {"p95_error_px", r.p95_error_px},
           {"max_error_px", r.max_error_px},
-          {"loop_ms_median", QuantileOf(r.loop_ms, 0.5)},
-          {"loop_ms_p95", QuantileOf(r.loop_ms, 0.95)},
-          {"loop_ms_max", QuantileOf(r.loop_ms, 1.0)},
-          {"estimate_ms_median", QuantileOf(r.estimate_ms, 0.5)},
-          {"capture_ms_median", QuantileOf(r.grab_ms, 0.5)}};
+          {"loop_ms_median", Quantile(r.loop_ms, 0.5)},
+          {"loop_ms_p95", Quantile(r.loop_ms, 0.95)},
+          {"loop_ms_max", Quantile(r.loop_ms, 1.0)},
+          {"estimate_ms_median", Quantile(r.estimate_ms, 0.5)},
+          {"capture_ms_median", Quantile(r.grab_ms, 0.5)}};
 }
 
 int RunBenchServo(BenchServoCommandOptions opt) {
@@ -72,9 +73,9 @@ int RunBenchServo(BenchServoCommandOptions opt) {
        << ", feed-forward " << (opt.no_feed_forward ? "off" : "on") << "\n";
   for (const ServoBenchRun& r : runs) {
     text << r.name << ": " << r.frames << " frames; loop (capture excluded) median "
-         << QuantileOf(r.loop_ms, 0.5) << " ms, 95% " << QuantileOf(r.loop_ms, 0.95) << " ms, max "
-         << QuantileOf(r.loop_ms, 1.0) << " ms; estimate median " << QuantileOf(r.estimate_ms, 0.5)
-         << " ms; capture (render) median " << QuantileOf(r.grab_ms, 0.5) << " ms\n";
+         << Quantile(r.loop_ms, 0.5) << " ms, 95% " << Quantile(r.loop_ms, 0.95) << " ms, max "
+         << Quantile(r.loop_ms, 1.0) << " ms; estimate median " << Quantile(r.estimate_ms, 0.5)
+         << " ms; capture (render) median " << Quantile(r.grab_ms, 0.5) << " ms\n";
     text << "  true target error: start " << r.start_error_px << " px, below 2 px at "
          << r.convergence_s << " s, final " << r.final_error_px << " px; after " << r.settle_s
          << " s mean " << r.mean_error_px << ", 95% " << r.p95_error_px << ", max "

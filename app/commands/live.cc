@@ -30,6 +30,7 @@
 #include "tracking/live/live_overlay.h"
 #include "tracking/live/servo_bench.h"
 #include "tracking/live/sim_rig.h"
+#include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
 namespace {
@@ -190,7 +191,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
 }
 
 nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop_reason) {
-  const double p50 = QuantileOf(s.loop_ms, 0.5), p95 = QuantileOf(s.loop_ms, 0.95);
+  const double p50 = Quantile(s.loop_ms, 0.5), p95 = Quantile(s.loop_ms, 0.95);
   return {
       {"stop_reason", stop_reason},
       {"interrupted", stop_reason.rfind("signal", 0) == 0},

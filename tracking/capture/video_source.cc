@@ -231,6 +231,10 @@ class VideoSource::Impl {
     if (frame->image.getSize() == 0) {
       throw InputError(path_ + ": frame " + std::to_string(first_ + next_) + " is empty");
     }
+    // vpVideoReader skips a file it cannot decode and hands over the next one instead.
+    if (reader_.getFrameIndex() != first_ + next_) {
+      throw InputError(path_ + ": frame " + std::to_string(first_ + next_) + " cannot be decoded");
+    }
     frame->frame_id = static_cast<std::uint64_t>(reader_.getFrameIndex());
     ++next_;
     return FrameStatus::kOk;

@@ -5,6 +5,7 @@
 
 #include "models/errors.h"
 #include "tracking/live/sim_rig.h"
+#include "tracking/tracker/track_bench.h"
 
 namespace linetrack {
 namespace {
@@ -35,7 +36,7 @@ ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig, int frames,
     for (double e : settled)
       sum += e;
     run.mean_error_px = sum / settled.size();
-    run.p95_error_px = QuantileOf(settled, 0.95);
+    run.p95_error_px = Quantile(settled, 0.95);
     run.max_error_px = *std::max_element(settled.begin(), settled.end());
   }
   return run;
@@ -58,13 +59,6 @@ bool ServoBenchOptions::Check(std::string* why) const {
     return false;
   }
   return servo.Check(why) && jitter.Check(why);
-}
-
-double QuantileOf(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
-  return values[std::min(values.size() - 1, rank > 0 ? rank - 1 : 0)];
 }
 
 std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const NavigableArea& area,

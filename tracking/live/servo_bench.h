@@ -55,7 +55,4 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
                                          const CameraIntrinsics& camera,
                                          const ServoBenchOptions& options);
 
-// The q-quantile (0..1) of `values`, nearest rank; 0 for none.
-double QuantileOf(std::vector<double> values, double q);
-
 }  // namespace linetrack

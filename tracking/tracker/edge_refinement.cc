@@ -1,0 +1,334 @@
+#include "tracking/tracker/edge_refinement.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <limits>
+
+#include "models/occlusion.h"
+#include "models/robot_pose.h"
+
+namespace linetrack {
+
+namespace {
+
+constexpr double kNearClip = 0.05;   // metres
+constexpr double kSampleStep = 0.5;  // pixels between samples of the edge profile
+constexpr double kJacobianStep = 1e-6;
+
+// Bilinear interpolation; false outside the image.
+bool Bilinear(const vpImage<unsigned char>& image, const Eigen::Vector2d& p, double* value) {
+  const double u = p.x(), v = p.y();
+  if (!(u >= 0.0 && v >= 0.0 && u < image.getWidth() - 1.0 && v < image.getHeight() - 1.0)) {
+    return false;
+  }
+  const unsigned u0 = static_cast<unsigned>(u), v0 = static_cast<unsigned>(v);
+  const double fu = u - u0, fv = v - v0;
+  const double top = (1.0 - fu) * image[v0][u0] + fu * image[v0][u0 + 1];
+  const double bottom = (1.0 - fu) * image[v0 + 1][u0] + fu * image[v0 + 1][u0 + 1];
+  *value = (1.0 - fv) * top + fv * bottom;
+  return true;
+}
+
+// A model edge as seen from the start pose: its 3D part inside the view and its image.
+struct ViewedEdge {
+  Eigen::Vector3d a, b;                 // world, clipped to the frustum
+  std::vector<Eigen::Vector2d> points;  // sub-pixel edge points attached to it
+};
+
+// Left-multiplied update: exp([omega, v]) * pose, in the camera frame.
+Eigen::Isometry3d Update(const Eigen::Isometry3d& pose, const Eigen::Matrix<double, 6, 1>& delta) {
+  const Eigen::Vector3d omega = delta.head<3>();
+  const double angle = omega.norm();
+  const Eigen::Matrix3d r = angle > 0.0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
+                                        : Eigen::Matrix3d::Identity();
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = r * pose.linear();
+  out.translation() = r * pose.translation() + delta.tail<3>();
+  return out;
+}
+
+// Signed distances of the edge points to the projected edges under `pose`; false when an edge
+// falls behind the camera.
+bool Residuals(const std::vector<ViewedEdge>& edges, const CameraIntrinsics& camera,
+               const Eigen::Isometry3d& pose, Eigen::VectorXd* residuals) {
+  int k = 0;
+  for (const ViewedEdge& edge : edges) {
+    const Eigen::Vector3d a = pose * edge.a, b = pose * edge.b;
+    if (a.z() <= kNearClip * 0.5 || b.z() <= kNearClip * 0.5) return false;
+    const Eigen::Vector2d pa = camera.Project(a), pb = camera.Project(b);
+    const Eigen::Vector2d d = pb - pa;
+    const double length = d.norm();
+    if (!(length > 1e-9)) return false;
+    const Eigen::Vector2d normal(-d.y() / length, d.x() / length);
+    for (const Eigen::Vector2d& p : edge.points)
+      (*residuals)[k++] = normal.dot(p - pa);
+  }
+  return true;
+}
+
+double WeightedCost(const Eigen::VectorXd& r, double huber) {
+  double cost = 0.0;
+  for (int i = 0; i < r.size(); ++i) {
+    const double a = std::abs(r[i]);
+    cost += a <= huber ? 0.5 * a * a : huber * (a - 0.5 * huber);
+  }
+  return cost;
+}
+
+double Rms(const Eigen::VectorXd& r) {
+  return r.size() ? std::sqrt(r.squaredNorm() / r.size()) : 0.0;
+}
+
+// The pose as a function of the unknowns: 6 (a left-multiplied twist on the start pose) or, with
+// a known height and tilt, 3 (x, y, heading of the robot pose; roll zero).
+class PoseParameters {
+ public:
+  PoseParameters(const Eigen::Isometry3d& start, const std::optional<KnownHeightTilt>& known)
+      : start_(start), known_(known) {
+    if (known_) {
+      const RobotPose robot = RobotPoseFromCamFromWorld(start);
+      base_ = Eigen::Vector3d(robot.x, robot.y, robot.heading);
+    }
+  }
+  int size() const { return known_ ? 3 : 6; }
+  Eigen::Isometry3d Pose(const Eigen::VectorXd& p) const {
+    if (!known_) return Update(start_, p);
+    return CamFromWorld(RobotPose{base_.x() + p[0], base_.y() + p[1], base_.z() + p[2],
+                                  known_->height, known_->tilt});
+  }
+
+ private:
+  Eigen::Isometry3d start_;
+  std::optional<KnownHeightTilt> known_;
+  Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
+};
+
+// Iteratively reweighted Gauss-Newton on the point-to-line distances of the edge points.
+EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraIntrinsics& camera,
+                                 const Eigen::Isometry3d& start,
+                                 const std::optional<KnownHeightTilt>& known,
+                                 const EdgeRefinementOptions& options) {
+  EdgeRefinement out;
+  out.cam_from_world = start;
+  std::vector<ViewedEdge> used;
+  for (ViewedEdge& e : viewed) {
+    if (!e.points.empty()) used.push_back(std::move(e));
+  }
+  int n = 0;
+  for (const ViewedEdge& e : used)
+    n += static_cast<int>(e.points.size());
+  out.points = n;
+  if (n < options.min_points) return out;
+
+  const PoseParameters parameters(start, known);
+  const int dof = parameters.size();
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(dof);
+  Eigen::VectorXd r(n), r_step(n);
+  Eigen::MatrixXd jacobian(n, dof);
+  if (!Residuals(used, camera, start, &r)) return out;
+  out.rms_before_px = Rms(r);
+  const double cost_before = WeightedCost(r, options.huber_px);
+  Eigen::Isometry3d pose = parameters.Pose(p);
+  if (!Residuals(used, camera, pose, &r)) return out;
+  // With a known height and tilt the start may lie off the constraint: compare with its image on
+  // the constraint instead.
+  const double reference_cost = known ? WeightedCost(r, options.huber_px) : cost_before;
+  for (int it = 0; it < options.iterations; ++it) {
+    for (int j = 0; j < dof; ++j) {
+      Eigen::VectorXd stepped = p;
+      stepped[j] += kJacobianStep;
+      if (!Residuals(used, camera, parameters.Pose(stepped), &r_step)) return out;
+      jacobian.col(j) = (r_step - r) / kJacobianStep;
+    }
+    Eigen::VectorXd w(n);
+    for (int i = 0; i < n; ++i) {
+      const double a = std::abs(r[i]);
+      w[i] = a <= options.huber_px ? 1.0 : options.huber_px / a;
+    }
+    const Eigen::MatrixXd h = jacobian.transpose() * w.asDiagonal() * jacobian;
+    const Eigen::VectorXd g = jacobian.transpose() * w.asDiagonal() * r;
+    const Eigen::VectorXd delta = -h.ldlt().solve(g);
+    if (!delta.allFinite()) return out;
+    p += delta;
+    pose = parameters.Pose(p);
+    if (!Residuals(used, camera, pose, &r)) return out;
+  }
+  out.rms_after_px = Rms(r);
+  if (!(WeightedCost(r, options.huber_px) <= reference_cost)) return out;
+  // Refuse large corrections: they mean the edge points were not where they were looked for.
+  double motion = 0.0;
+  for (const ViewedEdge& e : used) {
+    motion += (camera.Project(pose * e.a) - camera.Project(start * e.a)).norm() +
+              (camera.Project(pose * e.b) - camera.Project(start * e.b)).norm();
+  }
+  if (!(motion / (2.0 * used.size()) <= options.max_correction_px)) return out;
+  out.applied = true;
+  out.cam_from_world = pose;
+  return out;
+}
+
+}  // namespace
+
+bool EdgeRefinementOptions::Check(std::string* why) const {
+  if (!(association_px > 0.0) || !(ambiguity_px >= association_px) || !(end_margin_px >= 0.0) ||
+      !(search_px >= 1.0 && search_px <= 10.0)) {
+    *why = "edge refinement: association > 0, ambiguity >= association, search in [1, 10] px";
+    return false;
+  }
+  if (!(min_gradient > 0.0) || !(huber_px > 0.0) || iterations < 1 || min_points < 6 ||
+      !(max_correction_px > 0.0)) {
+    *why =
+        "edge refinement: positive gradient, Huber width and correction; >= 1 iteration, >= 6 "
+        "points";
+    return false;
+  }
+  return true;
+}
+
+bool EdgeAlignmentOptions::Check(std::string* why) const {
+  if (!solve.Check(why)) return false;
+  if (!(sample_step_px >= 1.0) || !(search_px >= solve.search_px && search_px <= 50.0) ||
+      rounds < 1 || rounds > 5) {
+    *why = "edge alignment: sample step >= 1 px, search in [refinement search, 50] px, 1-5 rounds";
+    return false;
+  }
+  return true;
+}
+
+double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vector2d& point,
+                          const Eigen::Vector2d& normal, double search_px, double min_gradient) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector2d tangent(-normal.y(), normal.x());
+  const int half = static_cast<int>(std::ceil(search_px / kSampleStep)) + 1;
+  std::vector<double> profile(2 * half + 1);
+  for (int k = -half; k <= half; ++k) {
+    double sum = 0.0;
+    for (int s = -1; s <= 1; ++s) {
+      double value = 0.0;
+      if (!Bilinear(image, point + k * kSampleStep * normal + s * tangent, &value)) return nan;
+      sum += value;
+    }
+    profile[k + half] = sum / 3.0;
+  }
+  // Derivative at k = -half + 1 .. half - 1; its largest magnitude must lie within the window.
+  std::vector<double> derivative(profile.size(), 0.0);
+  int best = -1;
+  double best_magnitude = -1.0;
+  for (int k = 1; k + 1 < static_cast<int>(profile.size()); ++k) {
+    derivative[k] = (profile[k + 1] - profile[k - 1]) / (2.0 * kSampleStep);
+    if (std::abs((k - half) * kSampleStep) <= search_px &&
+        std::abs(derivative[k]) > best_magnitude) {
+      best_magnitude = std::abs(derivative[k]);
+      best = k;
+    }
+  }
+  if (best < 0 || best_magnitude < min_gradient) return nan;
+  // Centroid of the derivative over the step (same sign, above a quarter of the peak): unbiased
+  // for a step blurred symmetrically, and for the piecewise-linear profile of a sharp one.
+  const double sign = derivative[best] > 0.0 ? 1.0 : -1.0;
+  int lo = best, hi = best;
+  while (lo > 1 && sign * derivative[lo - 1] >= 0.25 * best_magnitude)
+    --lo;
+  while (hi + 2 < static_cast<int>(profile.size()) &&
+         sign * derivative[hi + 1] >= 0.25 * best_magnitude) {
+    ++hi;
+  }
+  if (lo <= 1 || hi + 2 >= static_cast<int>(profile.size())) return nan;  // step cut by the window
+  double weight = 0.0, moment = 0.0;
+  for (int k = lo; k <= hi; ++k) {
+    weight += sign * derivative[k];
+    moment += sign * derivative[k] * (k - half);
+  }
+  return moment / weight * kSampleStep;
+}
+
+EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
+                             const std::vector<Segment3>& edges,
+                             const std::vector<Eigen::Vector2d>& sites,
+                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
+                             const std::optional<KnownHeightTilt>& known) {
+  // The model edges in view and their images at the start pose.
+  std::vector<ViewedEdge> viewed;
+  std::vector<Segment2> images;
+  for (const Segment3& edge : edges) {
+    Segment3 clipped = edge;
+    if (!ClipToFrustum(start, camera, kNearClip, &clipped)) continue;
+    const Segment2 image_edge{camera.Project(start * clipped.a), camera.Project(start * clipped.b)};
+    if (image_edge.Length() < 2.0 * options.end_margin_px + 2.0) continue;
+    viewed.push_back(ViewedEdge{clipped.a, clipped.b, {}});
+    images.push_back(image_edge);
+  }
+  // Each site goes to the one projected edge it lies on, then to the sub-pixel step near it.
+  for (const Eigen::Vector2d& site : sites) {
+    int best = -1;
+    double best_distance = options.ambiguity_px, second = options.ambiguity_px;
+    for (size_t e = 0; e < images.size(); ++e) {
+      const Eigen::Vector2d d = images[e].b - images[e].a;
+      const double length = d.norm();
+      const double along = (site - images[e].a).dot(d) / length;
+      if (along < options.end_margin_px || along > length - options.end_margin_px) continue;
+      const double distance = std::abs(Cross2(d, site - images[e].a)) / length;
+      if (distance < best_distance) {
+        second = best_distance;
+        best_distance = distance;
+        best = static_cast<int>(e);
+      } else if (distance < second) {
+        second = distance;
+      }
+    }
+    if (best < 0 || best_distance > options.association_px || second < options.ambiguity_px) {
+      continue;
+    }
+    const Eigen::Vector2d d = (images[best].b - images[best].a).normalized();
+    const Eigen::Vector2d normal(-d.y(), d.x());
+    const double offset =
+        SubpixelEdgeOffset(image, site, normal, options.search_px, options.min_gradient);
+    if (std::isfinite(offset)) viewed[best].points.push_back(site + offset * normal);
+  }
+  return SolveOnEdgePoints(std::move(viewed), camera, start, known, options);
+}
+
+EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
+                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
+                            const EdgeAlignmentOptions& options,
+                            const std::optional<KnownHeightTilt>& known) {
+  EdgeRefinement out;
+  out.cam_from_world = start;
+  Eigen::Isometry3d pose = start;
+  for (int round = 0; round < options.rounds; ++round) {
+    EdgeRefinementOptions solve = options.solve;
+    solve.search_px = round == 0 ? options.search_px : options.solve.search_px;
+    solve.max_correction_px = solve.search_px;
+    std::vector<ViewedEdge> viewed;
+    for (const Segment3& part : visible) {
+      Segment3 clipped = part;
+      if (!ClipToFrustum(pose, camera, kNearClip, &clipped)) continue;
+      const Eigen::Vector2d a = camera.Project(pose * clipped.a);
+      const Eigen::Vector2d b = camera.Project(pose * clipped.b);
+      const double length = (b - a).norm();
+      if (length < 2.0 * solve.end_margin_px + options.sample_step_px) continue;
+      const Eigen::Vector2d d = (b - a) / length;
+      const Eigen::Vector2d normal(-d.y(), d.x());
+      ViewedEdge edge{clipped.a, clipped.b, {}};
+      for (double s = solve.end_margin_px; s <= length - solve.end_margin_px;
+           s += options.sample_step_px) {
+        const Eigen::Vector2d p = a + s * d;
+        const double offset =
+            SubpixelEdgeOffset(image, p, normal, solve.search_px, solve.min_gradient);
+        if (std::isfinite(offset)) edge.points.push_back(p + offset * normal);
+      }
+      viewed.push_back(std::move(edge));
+    }
+    const EdgeRefinement step = SolveOnEdgePoints(std::move(viewed), camera, pose, known, solve);
+    if (!step.applied) return out;
+    if (round == 0) out.rms_before_px = step.rms_before_px;
+    pose = step.cam_from_world;
+    out.points = step.points;
+    out.rms_after_px = step.rms_after_px;
+  }
+  out.applied = true;
+  out.cam_from_world = pose;
+  return out;
+}
+
+}  // namespace linetrack

@@ -1,0 +1,89 @@
+// Sub-pixel refinement of a tracked pose on the image edges. ViSP's moving edges sit on integer
+// pixels, which biases the pose by centimetres in deep scenes (docs/tracking.md, the hall). Each
+// good moving edge is attached to the projected model edge it lies on, moved to the sub-pixel
+// maximum of the image gradient along that edge's normal, and the pose is refined by iteratively
+// reweighted Gauss-Newton on the point-to-line distances (Huber weights).
+#pragma once
+
+#include <visp3/core/vpImage.h>
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "models/camera.h"
+#include "models/geometry.h"
+
+namespace linetrack {
+
+struct EdgeRefinementOptions {
+  double association_px = 2.0;     // a site belongs to a projected edge closer than this
+  double ambiguity_px = 3.0;       // and no other edge may be closer than this
+  double end_margin_px = 4.0;      // sites this close to a projected edge's end are not used
+  double search_px = 2.0;          // half length of the sub-pixel search along the normal
+  double min_gradient = 3.0;       // grey levels per pixel for an edge point
+  double huber_px = 0.5;           // residuals beyond this are down-weighted
+  int iterations = 5;              // Gauss-Newton iterations
+  int min_points = 20;             // fewer edge points: the pose is left as it is
+  double max_correction_px = 3.0;  // a larger mean image motion is refused
+
+  bool Check(std::string* why) const;
+};
+
+// Sub-pixel offset (pixels along the unit `normal`) of the strongest intensity step within
+// +-search_px of `point`: central differences of bilinear samples every half pixel, averaged over
+// three parallel lines one pixel apart; the offset is the centroid of the derivative over the
+// step around its peak. NaN when the strongest step is weaker than min_gradient (grey levels per
+// pixel) or is cut by the window's end.
+double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vector2d& point,
+                          const Eigen::Vector2d& normal, double search_px, double min_gradient);
+
+// A robot camera's known height (metres) and tilt (radians): with it the refinement estimates
+// x, y and heading only, with zero roll (conventions of method.md).
+struct KnownHeightTilt {
+  double height = 0.0;
+  double tilt = 0.0;
+};
+
+// The outcome of RefineOnEdges.
+struct EdgeRefinement {
+  bool applied = false;  // false: too few edge points, no improvement, or a refused correction
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // refined (or the start)
+  int points = 0;                                                    // edge points used
+  double rms_before_px = 0.0;  // point-to-line distances at the start pose
+  double rms_after_px = 0.0;
+};
+
+// Refines `start` (cam_from_world) so that the model `edges` (world) pass through the sub-pixel
+// edge points found near `sites` (pixels of the undistorted `image`, e.g. ViSP's good moving
+// edges). `camera` is the undistorted camera. With `known`, the result has that height and tilt
+// and zero roll.
+EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
+                             const std::vector<Segment3>& edges,
+                             const std::vector<Eigen::Vector2d>& sites,
+                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
+                             const std::optional<KnownHeightTilt>& known = std::nullopt);
+
+// Coarse alignment of a predicted pose (e.g. from the robot's odometry) before the moving edges
+// take over: edge points are searched along the normals of the projected visible model edges,
+// first within +-search_px, then within +-solve.search_px, each round followed by the
+// Gauss-Newton refinement.
+struct EdgeAlignmentOptions {
+  double sample_step_px = 6.0;  // distance between searches along a projected edge
+  double search_px = 12.0;      // first round's half search length
+  int rounds = 2;
+  EdgeRefinementOptions solve;  // later rounds search solve.search_px
+
+  bool Check(std::string* why) const;
+};
+
+// Aligns `start` on the image edges near the projections of `visible` (the visible parts of the
+// model edges at `start`, world). `applied` is false when a round finds too few points or does
+// not improve.
+EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
+                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
+                            const EdgeAlignmentOptions& options,
+                            const std::optional<KnownHeightTilt>& known = std::nullopt);
+
+}  // namespace linetrack

@@ -1,0 +1,217 @@
+#include "tracking/tracker/edge_tracker.h"
+
+#include <visp3/core/vpEigenConversion.h>
+#include <visp3/core/vpException.h>
+#include <visp3/mbt/vpMbGenericTracker.h>
+
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "models/errors.h"
+#include "models/wireframe.h"
+
+namespace linetrack {
+
+namespace {
+
+// ViSP prints the content of every model it loads on std::cout; linetrack's library code does
+// not print, so that output is swallowed while a model loads.
+class ScopedCoutSilencer {
+ public:
+  ScopedCoutSilencer() : saved_(std::cout.rdbuf(sink_.rdbuf())) {}
+  ~ScopedCoutSilencer() { std::cout.rdbuf(saved_); }
+
+ private:
+  std::ostringstream sink_;
+  std::streambuf* saved_;
+};
+
+// ViSP's vpMeSite::NO_SUPPRESSION: a moving edge found and kept.
+constexpr double kGoodSiteState = 0.0;
+
+}  // namespace
+
+vpHomogeneousMatrix ToVispPose(const Eigen::Isometry3d& cam_from_world) {
+  vpHomogeneousMatrix cMo;
+  vp::eigen2visp(Eigen::MatrixXd(cam_from_world.matrix()), cMo);
+  return cMo;
+}
+
+Eigen::Isometry3d FromVispPose(const vpHomogeneousMatrix& cMo) {
+  Eigen::Matrix4d m;
+  vp::visp2eigen(cMo, m);
+  return Eigen::Isometry3d(m);
+}
+
+void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(model_path, ec)) {
+    throw InputError(Located(model_path, 0, "cannot read the model file"));
+  }
+  try {
+    ScopedCoutSilencer silence;
+    tracker->loadModel(model_path, false);
+  } catch (const vpException& e) {
+    throw InputError(
+        Located(model_path, 0, std::string("ViSP cannot load the model: ") + e.getMessage()));
+  }
+}
+
+void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsics& camera,
+                          vpMbGenericTracker* tracker) {
+  std::string why;
+  if (!settings.Check(&why)) throw InputError(Located(settings.source, 0, why));
+  vpMe me;
+  me.setMaskSize(static_cast<unsigned>(settings.me.mask_size));
+  me.setMaskNumber(static_cast<unsigned>(settings.me.mask_count));
+  me.setRange(static_cast<unsigned>(settings.me.range));
+  me.setThreshold(settings.me.threshold);
+  me.setMu1(settings.me.mu1);
+  me.setMu2(settings.me.mu2);
+  me.setSampleStep(settings.me.sample_step * settings.pass_step_factor);
+  tracker->setMovingEdge(me);
+  vpCameraParameters cam;
+  cam.initPersProjWithoutDistortion(camera.px, camera.py, camera.u0, camera.v0);
+  tracker->setCameraParameters(cam);
+  const VisibilitySettings& v = settings.visibility;
+  tracker->setAngleAppear(vpMath::rad(v.angle_appear_deg));
+  tracker->setAngleDisappear(vpMath::rad(v.angle_disappear_deg));
+  tracker->setNearClippingDistance(v.near_clipping_m);
+  tracker->setFarClippingDistance(v.far_clipping_m);
+  unsigned clipping = vpMbtPolygon::NEAR_CLIPPING | vpMbtPolygon::FAR_CLIPPING;
+  if (v.fov_clipping) clipping |= vpMbtPolygon::FOV_CLIPPING;
+  tracker->setClipping(clipping);
+  tracker->setScanLineVisibilityTest(v.scanline);
+  tracker->setMaxIter(static_cast<unsigned>(settings.max_iterations));
+  // ViSP records the state of each moving edge (found, rejected and why) only for display;
+  // linetrack reads it for the share of good moving edges.
+  tracker->setDisplayFeatures(true);
+  tracker->setGoodMovingEdgesRatioThreshold(settings.good_edge_ratio);
+}
+
+EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
+                         const TrackerSettings& settings)
+    : tracker_(std::make_unique<vpMbGenericTracker>(1, vpMbGenericTracker::EDGE_TRACKER)),
+      camera_(camera.Undistorted()),
+      settings_(settings) {
+  if (camera_.width <= 0 || camera_.height <= 0) {
+    throw InputError("camera '" + camera_.name + "': the image size is needed to track");
+  }
+  LoadVispModel(model_path, tracker_.get());
+  model_ = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  occlusion_ = std::make_unique<OcclusionTester>(*model_);
+  for (const ModelEdge& edge : model_->edges())
+    edges_.push_back(edge.segment);
+  try {
+    ConfigureVispTracker(settings_, camera_, tracker_.get());
+  } catch (const vpException& e) {
+    throw InputError(
+        Located(settings_.source, 0, std::string("ViSP rejects the settings: ") + e.getMessage()));
+  }
+}
+
+EdgeTracker::~EdgeTracker() = default;
+
+EdgeTrackResult EdgeTracker::Start(const vpImage<unsigned char>& image,
+                                   const Eigen::Isometry3d& cam_from_world) {
+  EdgeTrackResult result;
+  started_ = false;
+  try {
+    tracker_->initFromPose(image, ToVispPose(cam_from_world));
+    result.ok = true;
+    result.cam_from_world = FromVispPose(tracker_->getPose());
+    started_ = true;
+  } catch (const vpException& e) {
+    result.reason = std::string("ViSP: ") + e.getMessage();
+  }
+  return result;
+}
+
+EdgeTrackResult EdgeTracker::StartFromPrediction(const vpImage<unsigned char>& image,
+                                                 const Eigen::Isometry3d& predicted,
+                                                 const std::optional<KnownHeightTilt>& known) {
+  std::vector<Segment3> visible;
+  for (const ProjectedEdge& edge : ProjectVisibleEdges(*model_, *occlusion_, predicted, camera_))
+    visible.push_back(edge.world);
+  const EdgeRefinement aligned =
+      AlignToEdges(image, camera_, visible, predicted, settings_.alignment, known);
+  if (!aligned.applied) {
+    started_ = false;
+    EdgeTrackResult result;
+    result.reason = "too few image edges near the predicted pose (" +
+                    std::to_string(aligned.points) + " points)";
+    return result;
+  }
+  return Start(image, aligned.cam_from_world);
+}
+
+EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool with_covariance,
+                                   const std::optional<KnownHeightTilt>& known) {
+  EdgeTrackResult result;
+  if (!started_) {
+    result.reason = "the tracker has not been started";
+    return result;
+  }
+  try {
+    int passes = 0;
+    for (; passes < settings_.passes; ++passes) {
+      const bool last = passes + 1 == settings_.passes;
+      tracker_->setProjectionErrorComputation(last);
+      tracker_->setCovarianceComputation(last && with_covariance);
+      tracker_->track(image);
+    }
+    EdgeTrackResult measured = Measure(image, with_covariance, known);
+    measured.health.passes = passes;
+    return measured;
+  } catch (const vpException& e) {
+    started_ = false;
+    result.reason = std::string("ViSP: ") + e.getMessage();
+    return result;
+  }
+}
+
+EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool with_covariance,
+                                     const std::optional<KnownHeightTilt>& known) {
+  EdgeTrackResult result;
+  result.ok = true;
+  result.cam_from_world = FromVispPose(tracker_->getPose());
+  result.visp_cam_from_world = result.cam_from_world;
+  TrackHealth& health = result.health;
+  health.projection_error_deg = tracker_->getProjectionError();
+  std::vector<Eigen::Vector2d> good_sites;
+  for (const std::vector<double>& feature : tracker_->getFeaturesForDisplay()) {
+    if (feature.size() < 4 || feature[0] != 0.0)
+      continue;  // type 0: a moving edge {0, i, j, state}
+    ++health.edges_total;
+    if (feature[3] != kGoodSiteState) continue;
+    ++health.edges_good;
+    good_sites.emplace_back(feature[2], feature[1]);
+  }
+  if (settings_.refine_subpixel) {
+    const EdgeRefinement refined = RefineOnEdges(
+        image, camera_, edges_, good_sites, result.cam_from_world, settings_.refinement, known);
+    health.refined = refined.applied;
+    health.refined_points = refined.points;
+    if (refined.applied) {
+      result.cam_from_world = refined.cam_from_world;
+      health.refined_rms_before_px = refined.rms_before_px;
+      health.refined_rms_after_px = refined.rms_after_px;
+    }
+  }
+  if (!with_covariance) return result;
+  const vpMatrix covariance = tracker_->getCovarianceMatrix();
+  if (covariance.getRows() == 6 && covariance.getCols() == 6) {
+    Eigen::Matrix<double, 6, 6> c;
+    for (int r = 0; r < 6; ++r) {
+      for (int k = 0; k < 6; ++k)
+        c(r, k) = covariance[r][k];
+    }
+    const Eigen::Vector2d sigmas = CovarianceSigmas(c);
+    health.position_sigma_m = sigmas.x();
+    health.rotation_sigma_deg = vpMath::deg(sigmas.y());
+  }
+  return result;
+}
+
+}  // namespace linetrack

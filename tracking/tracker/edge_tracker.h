@@ -1,0 +1,99 @@
+// ViSP's model-based moving-edge tracker (vpMbGenericTracker, EDGE features) behind a small
+// interface: start from a pose, track a frame, measure its health. ViSP's exceptions stop here:
+// a failed call is a result with a reason. Images must be undistorted (ImageUndistorter).
+#pragma once
+
+#include <visp3/core/vpHomogeneousMatrix.h>
+#include <visp3/core/vpImage.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "models/camera.h"
+#include "models/geometry.h"
+#include "models/occlusion.h"
+#include "models/wireframe.h"
+#include "tracking/tracker/tracker_settings.h"
+#include "tracking/tracker/tracking_health.h"
+
+class vpMbGenericTracker;
+
+namespace linetrack {
+
+// The outcome of Start() or Track().
+struct EdgeTrackResult {
+  bool ok = false;     // false: ViSP failed (reason says why); the pose is then meaningless
+  std::string reason;  // ViSP's message when !ok
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
+  // ViSP's own pose before the sub-pixel refinement (equal to cam_from_world without it).
+  Eigen::Isometry3d visp_cam_from_world = Eigen::Isometry3d::Identity();
+  TrackHealth health;  // measured by Track() (Start() measures nothing)
+};
+
+class EdgeTracker {
+ public:
+  // Loads the .cao model through ViSP (and linetrack's reader, for the edges the sub-pixel
+  // refinement uses) and applies `settings` and the (undistorted) camera, whose image size must
+  // be known. Throws InputError naming the model when it cannot be loaded, or naming the settings'
+  // source when they are invalid.
+  EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
+              const TrackerSettings& settings);
+  ~EdgeTracker();
+  EdgeTracker(const EdgeTracker&) = delete;
+  EdgeTracker& operator=(const EdgeTracker&) = delete;
+
+  // (Re)starts the tracker at `cam_from_world` on `image`: the moving edges are sampled there.
+  EdgeTrackResult Start(const vpImage<unsigned char>& image,
+                        const Eigen::Isometry3d& cam_from_world);
+
+  // Tracks `image` from the current pose (settings.passes passes) and measures the health. The pose
+  // covariance only `with_covariance`: ViSP computes it with a dense n x n weight matrix over the n
+  // moving edges, which costs several times the tracking. Needs a successful Start() since the last
+  // failure.
+  // With `known` (a robot's height and tilt) the refined pose respects them (3 unknowns).
+  EdgeTrackResult Track(const vpImage<unsigned char>& image, bool with_covariance = false,
+                        const std::optional<KnownHeightTilt>& known = std::nullopt);
+
+  // Aligns `predicted` (e.g. the last pose moved by the robot's odometry) on the edges of `image`
+  // (EdgeAlignmentOptions of the settings) and starts the tracker there; Track() then follows.
+  // Not ok when too few edges are found near the predicted model.
+  EdgeTrackResult StartFromPrediction(const vpImage<unsigned char>& image,
+                                      const Eigen::Isometry3d& predicted,
+                                      const std::optional<KnownHeightTilt>& known = std::nullopt);
+
+  // True after a successful Start() and until a Track() fails.
+  bool started() const { return started_; }
+
+  const TrackerSettings& settings() const { return settings_; }
+  const CameraIntrinsics& camera() const { return camera_; }
+
+ private:
+  EdgeTrackResult Measure(const vpImage<unsigned char>& image, bool with_covariance,
+                          const std::optional<KnownHeightTilt>& known);
+
+  std::unique_ptr<vpMbGenericTracker> tracker_;
+  std::unique_ptr<WireframeModel> model_;  // linetrack's reading of the model
+  std::unique_ptr<OcclusionTester> occlusion_;
+  std::vector<Segment3> edges_;  // the model's edges (world), for the sub-pixel refinement
+  CameraIntrinsics camera_;
+  TrackerSettings settings_;
+  bool started_ = false;
+};
+
+// cam_from_world <-> ViSP's cMo.
+vpHomogeneousMatrix ToVispPose(const Eigen::Isometry3d& cam_from_world);
+Eigen::Isometry3d FromVispPose(const vpHomogeneousMatrix& cMo);
+
+// Applies `settings` (moving edges, visibility, iterations) and the camera to a ViSP tracker;
+// also used to configure the bare ViSP baseline of `linetrack bench track`.
+void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsics& camera,
+                          vpMbGenericTracker* tracker);
+
+// Loads a .cao model into a ViSP tracker without ViSP's console output. Throws InputError naming
+// the file when ViSP cannot load it.
+void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker);
+
+}  // namespace linetrack

@@ -1,0 +1,107 @@
+#include "tracking/tracker/relocalizer.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "models/errors.h"
+
+namespace linetrack {
+
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+bool ValidBounds(const SearchBounds& b) {
+  return b.delta_t >= 0.0 && std::isfinite(b.delta_t) && b.delta_phi > 0.0 && b.delta_phi <= kPi;
+}
+
+}  // namespace
+
+bool RelocalizationOptions::Check(std::string* why) const {
+  if (!ValidBounds(initial) || !ValidBounds(after_loss) || !ValidBounds(max)) {
+    *why = "search bounds must have delta_t >= 0 and delta_phi in (0, 180] degrees";
+    return false;
+  }
+  if (!(growth_t >= 0.0) || !(growth_phi >= 0.0)) {
+    *why = "bound growth must be >= 0";
+    return false;
+  }
+  if (min_lines < 2) {
+    *why = "min_lines must be >= 2";
+    return false;
+  }
+  return true;
+}
+
+SearchBounds WidenedBounds(int frames_since_good, const RelocalizationOptions& options) {
+  const double frames = std::max(0, frames_since_good);
+  SearchBounds bounds;
+  bounds.delta_t =
+      std::min(options.max.delta_t, options.after_loss.delta_t + options.growth_t * frames);
+  bounds.delta_phi =
+      std::min(options.max.delta_phi, options.after_loss.delta_phi + options.growth_phi * frames);
+  return bounds;
+}
+
+RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
+                     const RobotPose& odometry_now) {
+  // Motion in the odometry frame at `then`: d = R(-h_then) (p_now - p_then).
+  const double c = std::cos(odometry_then.heading), s = std::sin(odometry_then.heading);
+  const double dx = odometry_now.x - odometry_then.x, dy = odometry_now.y - odometry_then.y;
+  const double forward = c * dx + s * dy, left = -s * dx + c * dy;
+  const double cg = std::cos(last_good.heading), sg = std::sin(last_good.heading);
+  RobotPose prior;
+  prior.x = last_good.x + cg * forward - sg * left;
+  prior.y = last_good.y + sg * forward + cg * left;
+  prior.heading = WrapAngle(last_good.heading + (odometry_now.heading - odometry_then.heading));
+  prior.height = odometry_now.height;
+  prior.tilt = odometry_now.tilt;
+  return prior;
+}
+
+Relocalizer::Relocalizer(const Localizer& localizer, LineExtractorFunction extractor,
+                         const RelocalizationOptions& options)
+    : localizer_(localizer), extractor_(std::move(extractor)), options_(options) {
+  std::string why;
+  if (!extractor_) throw InputError("relocalizer: no line extractor");
+  if (!options_.Check(&why)) throw InputError("relocalization options: " + why);
+}
+
+RelocalizationAttempt Relocalizer::Attempt(const vpImage<unsigned char>& undistorted,
+                                           const RobotPose& prior,
+                                           const SearchBounds& bounds) const {
+  RelocalizationAttempt attempt;
+  auto start = std::chrono::steady_clock::now();
+  LocalizationProblem problem;
+  for (const Segment2& line : extractor_(undistorted)) {
+    // The matcher rejects degenerate segments as bad input; an extractor may produce them.
+    if (line.a.allFinite() && line.b.allFinite() && line.Length() >= 1.0)
+      problem.lines.push_back(line);
+  }
+  attempt.extract_ms = MillisecondsSince(start);
+  attempt.lines = static_cast<int>(problem.lines.size());
+  if (attempt.lines < options_.min_lines) {
+    attempt.reason = std::to_string(attempt.lines) + " lines extracted";
+    return attempt;
+  }
+  problem.prior = prior.Planar();
+  problem.delta_t = bounds.delta_t;
+  problem.delta_phi = bounds.delta_phi;
+  problem.height = prior.height;
+  problem.tilt = prior.tilt;
+  start = std::chrono::steady_clock::now();
+  const LocalizationResult result = localizer_.Localize(problem);
+  attempt.match_ms = MillisecondsSince(start);
+  attempt.found = result.found;
+  if (result.found) {
+    attempt.cam_from_world = result.cam_from_world;
+  } else {
+    attempt.reason = "matcher: " + result.reason;
+  }
+  return attempt;
+}
+
+}  // namespace linetrack

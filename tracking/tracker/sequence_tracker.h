@@ -1,0 +1,155 @@
+// Tracking that starts and recovers by itself: each frame is undistorted and tracked with the
+// moving edges; a pose is kept only when the tracker's health, the robot's known height and tilt
+// and the motion since the last good pose agree. When lost, the next frames try to find the pose
+// again (the matcher around the robot's prior with widening bounds, and a restart from the last
+// good pose), and every candidate is verified by tracking it on its frame.
+#pragma once
+
+#include <visp3/core/vpImage.h>
+
+#include <Eigen/Geometry>
+#include <deque>
+#include <optional>
+#include <string>
+
+#include "models/robot_pose.h"
+#include "tracking/tracker/edge_tracker.h"
+#include "tracking/tracker/image_undistorter.h"
+#include "tracking/tracker/relocalizer.h"
+#include "tracking/tracker/tracking_health.h"
+
+namespace linetrack {
+
+// The state of a frame, as frames.csv reports it.
+enum class TrackStatus {
+  kInitialising,  // no pose found yet (no pose)
+  kTracking,      // pose followed from the previous frame, or the first pose (start file, matcher)
+  kLost,          // the pose was lost or rejected on this frame and not found again (no pose)
+  kRelocalised,   // the pose was found again after a loss (matcher or restart), verified
+};
+
+// "initialising", "tracking", "lost", "relocalised".
+const char* ToString(TrackStatus status);
+
+// What a robot knows at a frame: its camera height and tilt (head encoders) and, with a prior
+// file, the odometry's position and heading.
+struct RobotReading {
+  std::optional<Pose3Dof> odometry;
+  double height = 0.0;  // metres
+  double tilt = 0.0;    // radians, positive down
+};
+
+struct SequenceTrackerOptions {
+  HealthThresholds health;
+  MotionLimits motion;
+  RobotConstraint robot_tolerances;  // its height and tilt are replaced by each frame's reading
+  // After a loss, also try restarting the tracker from the last good pose (the only recovery of
+  // a free camera; for a robot, tried after the matcher).
+  bool restart_from_last_good = true;
+  // A restart from the last good pose is tried only this many frames after it (the camera moves).
+  int restart_window = 30;
+  // With odometry, the last pose is moved by the odometry's motion since the last frame and
+  // aligned on the image edges before tracking when that motion shifts the image by more than
+  // prediction_min_px (estimated for scene points prediction_depth_m away).
+  double prediction_min_px = 3.0;
+  double prediction_depth_m = 2.0;
+  // A jump of the projection error to more than jump_ratio times its median over the last
+  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
+  // (e.g. a door casing beside the modelled edge): the pose is dropped.
+  // A robot's pose must be confirmed by the sub-pixel refinement on the edges (with its height
+  // and tilt); otherwise ViSP's unconstrained pose would be reported.
+  bool robot_requires_refinement = true;
+  double jump_ratio = 3.0;
+  double jump_floor_deg = 8.0;
+  int jump_window = 15;
+
+  bool Check(std::string* why) const;
+};
+
+// The camera pose now from the last pose and the robot's readings then and now (odometry position
+// and heading, height, tilt): C_now C_then^-1 last, with C = CamFromWorld of a reading. Keeps the
+// last pose's own roll and small errors; only the relative motion of the odometry is used.
+Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const RobotPose& then,
+                                      const RobotPose& now);
+
+// What happened on one frame.
+struct FrameReport {
+  TrackStatus status = TrackStatus::kInitialising;
+  std::optional<Eigen::Isometry3d> cam_from_world;  // only for kTracking and kRelocalised
+  TrackHealth health;                               // of the last tracking on this frame
+  bool health_measured = false;
+  std::string source;  // where the pose came from: "tracker", "start pose", "matcher", "restart"
+  std::string note;    // why there is no pose (empty otherwise)
+  int lines = -1;      // segments extracted when the matcher ran, else -1
+  bool predicted = false;  // tracking started from the odometry's prediction
+  double undistort_ms = 0.0;
+  double track_ms = 0.0;       // tracking from the previous frame
+  double relocalize_ms = 0.0;  // matcher, restarts and their verification
+  double total_ms = 0.0;
+};
+
+class SequenceTracker {
+ public:
+  // `camera` is the camera of the incoming (distorted) frames; `tracker` must have been built
+  // for its undistorted model. `relocalizer` may be null (free camera: no matcher). Both must
+  // outlive the sequence tracker. Throws InputError on invalid options.
+  SequenceTracker(EdgeTracker* tracker, const CameraIntrinsics& camera,
+                  const Relocalizer* relocalizer, const SequenceTrackerOptions& options);
+
+  // Start from this pose (ViSP pose file) on the next frame, before any matcher.
+  void SetStartPose(const Eigen::Isometry3d& cam_from_world) { start_pose_ = cam_from_world; }
+
+  // Prior of the first localisation of a robot without a prior file (x, y, heading).
+  void SetInitialPrior(const Pose3Dof& prior) { initial_prior_ = prior; }
+
+  // Processes one frame taken at `t` seconds; `robot` is absent for a free camera.
+  FrameReport Process(const vpImage<unsigned char>& image, double t,
+                      const std::optional<RobotReading>& robot);
+
+  // The last frame, undistorted (for overlays).
+  const vpImage<unsigned char>& undistorted() const { return *undistorted_; }
+  EdgeTracker& tracker() { return *tracker_; }
+  int losses() const { return losses_; }
+  int recoveries() const { return recoveries_; }
+
+ private:
+  struct GoodPose {
+    Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
+    double t = 0.0;
+    std::optional<RobotReading> robot;  // what the robot read at that frame
+  };
+
+  // Empty when the tracked result can be kept at time t, else why not.
+  std::string Judge(const EdgeTrackResult& result, double t,
+                    const std::optional<RobotReading>& robot) const;
+  // Starts the tracker at `candidate`, tracks the frame from there and judges the result.
+  bool StartAndVerify(const Eigen::Isometry3d& candidate, double t,
+                      const std::optional<RobotReading>& robot, FrameReport* report);
+  // The matcher's prior for this frame (robot only) and its bounds; false when there is none.
+  bool MatcherPrior(const RobotReading& robot, RobotPose* prior, SearchBounds* bounds) const;
+  int FramesSinceGood() const { return static_cast<int>(frame_index_ - last_good_index_); }
+  // With odometry now and at the last frame: restarts the tracker from the predicted pose when
+  // the predicted image motion is large.
+  void MaybePredict(const std::optional<RobotReading>& robot, FrameReport* report);
+  void Accept(const EdgeTrackResult& result, double t, const std::optional<RobotReading>& robot,
+              const char* source, FrameReport* report);
+
+  EdgeTracker* tracker_;
+  ImageUndistorter undistorter_;
+  const Relocalizer* relocalizer_;
+  SequenceTrackerOptions options_;
+  const vpImage<unsigned char>* undistorted_ = nullptr;
+  vpImage<unsigned char> empty_;
+
+  std::optional<Eigen::Isometry3d> start_pose_;
+  std::optional<Pose3Dof> initial_prior_;
+  std::optional<GoodPose> last_good_;
+  std::deque<double> recent_projection_errors_;  // of the last good frames
+  bool following_ = false;  // the tracker holds a good pose from the previous frame
+  long frame_index_ = -1;   // frames processed - 1
+  long last_good_index_ = -1;
+  int losses_ = 0;
+  int recoveries_ = 0;
+};
+
+}  // namespace linetrack
