@@ -1,7 +1,10 @@
 #include "app/cli_common.h"
 
 #include <unistd.h>
+
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -92,6 +95,45 @@ CLI::App* BenchGroup(CLI::App& cli) {
       "bench", "Benchmarks: accuracy and speed figures on this machine (see docs/)");
   bench->require_subcommand(1);
   return bench;
+}
+
+namespace {
+
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void RecordStopSignal(int signal) {
+  g_stop_signal = signal;
+}
+
+}  // namespace
+
+struct StopSignals::Saved {
+  struct sigaction old_int {};
+  struct sigaction old_term {};
+};
+
+StopSignals::StopSignals() : saved_(std::make_unique<Saved>()) {
+  g_stop_signal = 0;
+  struct sigaction action {};
+  action.sa_handler = RecordStopSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, &saved_->old_int);
+  sigaction(SIGTERM, &action, &saved_->old_term);
+}
+
+StopSignals::~StopSignals() {
+  sigaction(SIGINT, &saved_->old_int, nullptr);
+  sigaction(SIGTERM, &saved_->old_term, nullptr);
+}
+
+int StopSignals::Received() {
+  return g_stop_signal;
+}
+
+std::string StopSignals::ReceivedName() {
+  const int signal = g_stop_signal;
+  if (signal == 0) return "";
+  return signal == SIGINT ? "SIGINT" : "SIGTERM";
 }
 
 void EnsureDirectory(const std::string& dir) {

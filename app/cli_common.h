@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,25 @@ void WriteFileAtomically(const std::string& path, const std::string& content);
 
 // The `bench` command group shared by the benchmarks (created by the first caller).
 CLI::App* BenchGroup(CLI::App& cli);
+
+// While an object lives, SIGINT and SIGTERM are recorded instead of ending the process, so that a
+// long run (replay, live) can stop cleanly; the previous handlers come back when it dies.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // The signal received since construction (SIGINT or SIGTERM), 0 for none.
+  static int Received();
+  // "SIGINT" or "SIGTERM" (empty for none).
+  static std::string ReceivedName();
+
+ private:
+  struct Saved;
+  std::unique_ptr<Saved> saved_;
+};
 
 // Creates `dir` (and parents) when missing; throws InputError when it cannot.
 void EnsureDirectory(const std::string& dir);

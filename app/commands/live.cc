@@ -10,9 +10,7 @@
 #include <visp3/gui/vpDisplayX.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
@@ -47,32 +45,6 @@ struct LiveCommandOptions {
   int snapshot_every = 30;
   bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
-};
-
-// Set by SIGINT/SIGTERM while a run is in progress.
-std::atomic<int> g_stop_signal{0};
-extern "C" void OnStopSignal(int signal) {
-  g_stop_signal = signal;
-}
-
-// Installs the stop handlers for the lifetime of the object, restoring the previous ones.
-class StopSignals {
- public:
-  StopSignals() {
-    g_stop_signal = 0;
-    struct sigaction action = {};
-    action.sa_handler = OnStopSignal;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &old_int_);
-    sigaction(SIGTERM, &action, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ = {}, old_term_ = {};
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -262,8 +234,8 @@ int RunLive(const LiveCommandOptions& opt) {
   {
     StopSignals signals;
     while (true) {
-      if (g_stop_signal != 0) {
-        stop_reason = std::string("signal ") + (g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
+      if (StopSignals::Received() != 0) {
+        stop_reason = "signal " + StopSignals::ReceivedName();
         break;
       }
       const LiveIteration it = loop.Step();
