@@ -19,15 +19,15 @@
 
 #include "app/commands.h"
 #include "app/live_output.h"
+#include "app/live_session.h"
+#include "app/localize_image.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/trajectory_io.h"
 #include "tracking/capture/source_factory.h"
 #include "tracking/head/head_factory.h"
-#include "tracking/head/head_pointing.h"
 #include "tracking/live/live_overlay.h"
 #include "tracking/live/servo_bench.h"
-#include "tracking/live/sim_rig.h"
 #include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
@@ -39,6 +39,7 @@ struct LiveCommandOptions {
   std::string head_start, head_start_offset;
   std::string head_model = "ptu46";
   std::string estimator = "auto";
+  std::string settings;
   double height = -1.0;
   double duration = 0.0;
   bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
@@ -79,20 +80,11 @@ class LiveWindow {
   std::unique_ptr<vpDisplayX> display_;
 };
 
-// Everything checked before any device is opened or file written.
-struct LivePlan {
-  bool sim = false;
-  SimCameraOptions sim_camera;
-  HeadModel head_model = HeadModel::kPtu46;
-  std::optional<Pose3Dof> prior;
-  std::vector<PriorRecord> prior_file;
-  LiveLoopOptions loop;
-  std::optional<Eigen::Vector2d> head_start, head_start_offset;  // radians
-  double duration = 0.0;                                         // 0: until stopped
-};
-
+// Every flag checked before any file is read, device opened or output written.
 LivePlan CheckFlags(const LiveCommandOptions& opt) {
   LivePlan plan;
+  plan.source_spec = opt.source;
+  plan.head_spec = opt.head;
   const SourceSpec source = ParseSourceSpec(opt.source);
   const HeadSpec head = ParseHeadSpec(opt.head);
   plan.sim = source.kind == SourceKind::kSim;
@@ -104,6 +96,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
     throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
   }
   CheckRange(opt.height, 0.05, 100.0, "--height");
+  plan.height = opt.height;
   if (!opt.prior.empty() && !opt.prior_file.empty()) {
     throw InputError("--prior and --prior-file: give one of them");
   }
@@ -135,16 +128,16 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
   plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
   CheckRange(plan.duration, 0.0, 1e7, "--duration");
-  if (opt.estimator != "auto" && opt.estimator != "truth") {
-    throw InputError("--estimator: expected auto or truth, got '" + opt.estimator + "'");
+  if (opt.estimator != "auto" && opt.estimator != "tracker" && opt.estimator != "truth") {
+    throw InputError("--estimator: expected auto, tracker or truth, got '" + opt.estimator + "'");
   }
+  plan.use_tracker = opt.estimator != "truth";
   if (!plan.sim) {
-    // The camera pose of real frames needs the tracker of issue 6 (tracking/tracker/), which is
-    // not part of this build yet: refuse rather than servo on nothing.
-    throw InputError(
-        "--source " + opt.source +
-        ": live tracking of a real camera needs the tracker (tracking/tracker/, not in "
-        "this build yet); only --source sim --head sim runs for now");
+    if (!plan.use_tracker) throw InputError("--estimator truth: only with --source sim");
+    if (!plan.prior && opt.prior_file.empty()) {
+      throw InputError("--prior or --prior-file: the matcher needs the robot's prior");
+    }
+    return plan;
   }
   plan.sim_camera.head_model = plan.head_model;
   plan.sim_camera.camera_height = opt.height;
@@ -193,35 +186,37 @@ nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop
 }
 
 int RunLive(const LiveCommandOptions& opt) {
-  LivePlan plan = CheckFlags(opt);
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
-  if (camera.width <= 0)
+  const LivePlan plan = CheckFlags(opt);
+  LiveInputs inputs;
+  inputs.camera = ReadCameraXml(opt.camera_path);
+  if (inputs.camera.width <= 0) {
     throw InputError(opt.camera_path + ": the camera file gives no image size");
+  }
   const WireframeModel model = WireframeModel::Load(opt.model_path);
   for (const std::string& w : model.warnings())
     spdlog::warn("{}", w);
+  inputs.model = &model;
+  if (!opt.prior_file.empty()) inputs.priors = ReadPriors(opt.prior_file);
+  if (!opt.prior_file.empty() && inputs.priors.empty()) {
+    throw InputError(opt.prior_file + ": no prior rows");
+  }
+  inputs.tracker.matcher = DetectedLineMatcherOptions({});
+  if (!opt.settings.empty()) inputs.tracker.settings = ReadTrackerSettings(opt.settings);
   std::optional<NavigableArea> area;
-  if (plan.sim_camera.path == SimPath::kLoop || plan.sim_camera.render_options.scene.clutter > 0) {
+  if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
+      plan.sim_camera.render_options.scene.clutter > 0) {
     NavigableAreaOptions area_options;
     area_options.sidecar_path = opt.nav_path;
     area = NavigableArea::FromModel(model, area_options);
+    inputs.area = &*area;
   }
-  SimHeadStart start;
-  SimulatedHeadOptions head_options;
-  if (plan.head_start) {
-    head_options.initial_pan = plan.head_start->x();
-    head_options.initial_tilt = plan.head_start->y();
-    std::string why;
-    if (!head_options.Check(&why)) throw InputError("--head-start: " + why);
-  }
-  if (plan.head_start_offset) start.offset_from_target = plan.head_start_offset;
-  SimulatedLiveRig rig(model, area ? &*area : nullptr, camera, plan.sim_camera, head_options,
-                       plan.loop, start);
-  LiveLoop& loop = rig.loop();
+  LiveSession session(plan, inputs);
+  LiveLoop& loop = session.loop();
+  const CameraIntrinsics& camera = inputs.camera;
 
-  LiveOutput output(opt.out, /*with_truth=*/true);
-  spdlog::info("live: started: source {}, head {}, estimator {}, {} s", rig.camera().Describe(),
-               rig.head().Describe(), rig.estimator().Describe(), plan.duration);
+  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr);
+  spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
+               session.DescribeHead(), session.DescribeEstimator(), plan.duration);
   const std::vector<ProjectedEdge> no_edges;
   LiveWindow window;
   bool window_tried = false;
@@ -229,8 +224,12 @@ int RunLive(const LiveCommandOptions& opt) {
   LiveSummary summary;
   std::string stop_reason = "duration";
   HeadResult stopped;
-  // Simulated time: the duration is a number of frames (0: until stopped).
-  const std::int64_t max_frames = std::llround(plan.duration * plan.sim_camera.fps);
+  // Simulated time: the duration is a number of frames; real devices: wall-clock seconds. 0: until
+  // stopped (or the end of a recorded source).
+  const std::int64_t max_frames = plan.sim ? std::llround(plan.duration * plan.sim_camera.fps) : 0;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(plan.duration));
   {
     StopSignals signals;
     while (true) {
@@ -247,8 +246,7 @@ int RunLive(const LiveCommandOptions& opt) {
       if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
         spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
       }
-      const Eigen::Isometry3d truth = rig.camera().last_cam_from_world();
-      output.Add(it, &truth);
+      output.Add(it, session.truth());
       const bool snapshot =
           opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
       const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
@@ -269,15 +267,16 @@ int RunLive(const LiveCommandOptions& opt) {
         if (window.is_open()) window.Show(overlay);
       }
       if (max_frames > 0 && summary.frames >= max_frames) break;
+      if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
     }
     stopped = loop.SafeStop();  // the head first, then the files
     if (!stopped.ok()) spdlog::error("head: could not stop: {}", stopped.message);
   }
   nlohmann::ordered_json json = SummaryJson(summary, stop_reason);
   json["head_stopped_at_end"] = stopped.ok();
-  json["source"] = rig.camera().Describe();
-  json["head"] = rig.head().Describe();
-  json["estimator"] = rig.estimator().Describe();
+  json["source"] = session.DescribeSource();
+  json["head"] = session.DescribeHead();
+  json["estimator"] = session.DescribeEstimator();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
   output.Finish(json);
@@ -330,8 +329,9 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                 "Show the overlay of every frame in a window (X11); headless when none answers");
   cmd->add_option("--nav", opt->nav_path, "Navigable-area file for sim:path=loop and clutter");
   cmd->add_option("--estimator", opt->estimator,
-                  "Camera pose: auto | truth (simulator's true pose, sim only)")
+                  "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();
+  cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
   cmd->callback([opt, action, cmd] {
     opt->duration_given = cmd->get_option("--duration")->count() > 0;
     *action = [opt] { return RunLive(*opt); };

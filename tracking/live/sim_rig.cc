@@ -10,7 +10,7 @@ SimulatedLiveRig::SimulatedLiveRig(const WireframeModel& model, const NavigableA
                                    const SimCameraOptions& camera_options,
                                    const SimulatedHeadOptions& head_options,
                                    const LiveLoopOptions& loop_options, const SimHeadStart& start,
-                                   const PoseJitterOptions& jitter)
+                                   const PoseJitterOptions& jitter, CameraPoseEstimator* estimator)
     : undistorted_(camera.Undistorted()), camera_(model, area, camera, camera_options) {
   SimulatedHeadOptions head = head_options;
   if (start.offset_from_target) {
@@ -29,12 +29,13 @@ SimulatedLiveRig::SimulatedLiveRig(const WireframeModel& model, const NavigableA
   head_ = std::make_unique<SimulatedHead>(head);
   camera_.AttachHead(head_.get());
   truth_ = std::make_unique<SimulatorTruthEstimator>(&camera_, jitter);
+  estimator_ = estimator != nullptr ? estimator : truth_.get();
   LiveLoopOptions options = loop_options;
   options.servo.model = camera_options.head_model;
   options.crossing_height = camera_.crossing_height();
   loop_ = std::make_unique<LiveLoop>(
-      &camera_, head_.get(), truth_.get(), [this](double t) { return camera_.OdometryAt(t); },
-      model, undistorted_, options);
+      &camera_, head_.get(), estimator_, [this](double t) { return camera_.OdometryAt(t); }, model,
+      undistorted_, options);
 }
 
 double SimulatedLiveRig::TrueErrorPx() const {

@@ -26,17 +26,19 @@ class SimulatedLiveRig {
  public:
   // `camera` is the camera of the frames (its undistorted model serves the loop); `model` and
   // `area` must outlive the rig. The loop's crossing height is taken from the simulated camera.
-  // Throws InputError on invalid options, or when an offset start is asked without a target or
-  // the target cannot be looked at.
+  // `estimator` gives the poses (not owned; e.g. the tracker); null: the simulator's truth,
+  // jittered by `jitter`. Throws InputError on invalid options, or when an offset start is asked
+  // without a target or the target cannot be looked at.
   SimulatedLiveRig(const WireframeModel& model, const NavigableArea* area,
                    const CameraIntrinsics& camera, const SimCameraOptions& camera_options,
                    const SimulatedHeadOptions& head_options, const LiveLoopOptions& loop_options,
-                   const SimHeadStart& start = {}, const PoseJitterOptions& jitter = {});
+                   const SimHeadStart& start = {}, const PoseJitterOptions& jitter = {},
+                   CameraPoseEstimator* estimator = nullptr);
 
   SimulatedCamera& camera() { return camera_; }
   SimulatedHead& head() { return *head_; }
   LiveLoop& loop() { return *loop_; }
-  CameraPoseEstimator& estimator() { return *truth_; }
+  CameraPoseEstimator& estimator() { return *estimator_; }
 
   // Distance in pixels of the loop's target from its desired pixel in the last frame, from the
   // true pose (undistorted image); -1 before the loop has a target.
@@ -47,6 +49,7 @@ class SimulatedLiveRig {
   SimulatedCamera camera_;
   std::unique_ptr<SimulatedHead> head_;
   std::unique_ptr<SimulatorTruthEstimator> truth_;
+  CameraPoseEstimator* estimator_ = nullptr;
   std::unique_ptr<LiveLoop> loop_;
 };
 
