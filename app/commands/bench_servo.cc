@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/localize_image.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "tracking/live/servo_bench.h"
@@ -20,6 +21,8 @@ struct BenchServoCommandOptions {
   std::string model_path, camera_path, nav_path;
   ServoBenchOptions bench;
   double jitter_deg = 0.0, jitter_m = 0.0;
+  std::string estimator = "tracker";
+  std::string settings;
   bool no_feed_forward = false;
   bool json = false;
 };
@@ -30,6 +33,9 @@ nlohmann::ordered_json ToJson(const ServoBenchRun& r) {
           {"start_error_px", r.start_error_px},
           {"convergence_s", r.convergence_s},
           {"final_error_px", r.final_error_px},
+          {"frames_with_pose", r.frames_with_pose},
+          {"max_position_error_m", r.max_position_error_m},
+          {"max_rotation_error_deg", r.max_rotation_error_deg},
           {"settle_s", r.settle_s},
           {"mean_error_px", r.mean_error_px},
           {"p95_error_px", r.p95_error_px},
@@ -45,6 +51,12 @@ int RunBenchServo(BenchServoCommandOptions opt) {
   opt.bench.jitter.rotation_sigma = DegToRad(opt.jitter_deg);
   opt.bench.jitter.translation_sigma = opt.jitter_m;
   if (opt.no_feed_forward) opt.bench.servo.target_motion_filter = 0.0;
+  if (opt.estimator != "tracker" && opt.estimator != "truth") {
+    throw InputError("--estimator: expected tracker or truth, got '" + opt.estimator + "'");
+  }
+  opt.bench.use_tracker = opt.estimator == "tracker";
+  opt.bench.tracker.matcher = DetectedLineMatcherOptions({});
+  if (!opt.settings.empty()) opt.bench.tracker.settings = ReadTrackerSettings(opt.settings);
   std::string why;
   if (!opt.bench.Check(&why)) throw InputError("bench servo: " + why);
   const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
@@ -66,8 +78,10 @@ int RunBenchServo(BenchServoCommandOptions opt) {
   std::ostringstream text;
   text << std::fixed << std::setprecision(3);
   text << "camera " << camera.width << "x" << camera.height << ", " << opt.bench.fps
-       << " frames/s simulated, estimator: simulator truth"
-       << (opt.bench.jitter.rotation_sigma > 0 || opt.bench.jitter.translation_sigma > 0
+       << " frames/s simulated, estimator: "
+       << (opt.bench.use_tracker ? "tracker" : "simulator truth")
+       << (!opt.bench.use_tracker &&
+                   (opt.bench.jitter.rotation_sigma > 0 || opt.bench.jitter.translation_sigma > 0)
                ? " with jitter"
                : "")
        << ", feed-forward " << (opt.no_feed_forward ? "off" : "on") << "\n";
@@ -80,6 +94,9 @@ int RunBenchServo(BenchServoCommandOptions opt) {
          << r.convergence_s << " s, final " << r.final_error_px << " px; after " << r.settle_s
          << " s mean " << r.mean_error_px << ", 95% " << r.p95_error_px << ", max "
          << r.max_error_px << " px\n";
+    text << "  poses: " << r.frames_with_pose << " of " << r.frames
+         << " frames; largest error against the truth " << r.max_position_error_m * 1000.0
+         << " mm, " << r.max_rotation_error_deg << " deg\n";
   }
   std::cout << text.str();
   return kExitOk;
@@ -91,8 +108,8 @@ void AddBenchServo(CLI::App& cli, CommandAction* action) {
   auto opt = std::make_shared<BenchServoCommandOptions>();
   CLI::App* cmd = BenchGroup(cli)->add_subcommand(
       "servo",
-      "The live loop on the simulator: time per iteration excluding capture, convergence from a "
-      "10/5 degree offset, target error while the robot drives the loop");
+      "The live loop on the simulator: time per iteration excluding capture (tracker included), "
+      "convergence from a 10/5 degree offset, target error while the robot drives the loop");
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
   cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (frame size)")->required();
   cmd->add_option("--nav", opt->nav_path, "Navigable-area file (default: MODEL.nav.json)");
@@ -110,6 +127,10 @@ void AddBenchServo(CLI::App& cli, CommandAction* action) {
       "Grey frames instead of rendered ones");
   cmd->add_flag("--no-feed-forward", opt->no_feed_forward,
                 "Turn off the compensation of the target's own motion");
+  cmd->add_option("--estimator", opt->estimator,
+                  "tracker (rendered frames) | truth (the simulator's pose)")
+      ->capture_default_str();
+  cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
   cmd->add_flag("--json", opt->json, "Print JSON");
   cmd->callback([opt, action] { *action = [opt] { return RunBenchServo(*opt); }; });
 }

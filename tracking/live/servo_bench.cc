@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "models/errors.h"
+#include "models/geometry.h"
 #include "tracking/live/sim_rig.h"
 #include "tracking/tracker/track_bench.h"
+#include "tracking/tracker/tracking_health.h"
 
 namespace linetrack {
 namespace {
@@ -25,6 +27,13 @@ ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig, int frames,
     run.loop_ms.push_back(it.loop_ms);
     run.estimate_ms.push_back(it.estimate_ms);
     run.grab_ms.push_back(it.grab_ms);
+    if (it.estimate.has_pose()) {
+      ++run.frames_with_pose;
+      const PoseDifference d =
+          ComparePoses(*it.estimate.cam_from_world, rig->camera().last_cam_from_world());
+      run.max_position_error_m = std::max(run.max_position_error_m, d.translation);
+      run.max_rotation_error_deg = std::max(run.max_rotation_error_deg, RadToDeg(d.rotation));
+    }
     const double error = rig->TrueErrorPx();
     if (k == 0) run.start_error_px = error;
     if (run.convergence_s < 0.0 && error >= 0.0 && error < kConvergedPx) run.convergence_s = it.t;
@@ -54,6 +63,10 @@ bool ServoBenchOptions::Check(std::string* why) const {
     *why = "run lengths must be >= 0 s, not both 0";
     return false;
   }
+  if (use_tracker && !render) {
+    *why = "the tracker needs rendered frames";
+    return false;
+  }
   if (!(settle_seconds >= 0.0)) {
     *why = "settle time must be >= 0 s";
     return false;
@@ -72,6 +85,11 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
   sim.head_model = options.servo.model;
   LiveLoopOptions loop;
   loop.servo = options.servo;
+  // A fresh tracker per run (null: the simulator's truth).
+  auto MakeTracker = [&]() -> std::unique_ptr<TrackerPoseEstimator> {
+    if (!options.use_tracker) return nullptr;
+    return std::make_unique<TrackerPoseEstimator>(model, area, camera, options.tracker);
+  };
   std::vector<ServoBenchRun> runs;
   if (options.still_seconds > 0.0) {
     sim.path = SimPath::kStill;
@@ -79,8 +97,9 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     loop.target = options.still_target;
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d(options.start_pan_offset, options.start_tilt_offset);
+    const auto tracker = MakeTracker();
     SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter);
+                         options.jitter, tracker.get());
     runs.push_back(RunOne("still", &rig,
                           static_cast<int>(std::lround(options.still_seconds * options.fps)),
                           options.still_seconds / 2));
@@ -90,8 +109,9 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     loop.target = options.drive_target;
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d::Zero();
+    const auto tracker = MakeTracker();
     SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter);
+                         options.jitter, tracker.get());
     runs.push_back(RunOne("drive", &rig,
                           static_cast<int>(std::lround(options.drive_seconds * options.fps)),
                           options.settle_seconds));

@@ -12,6 +12,7 @@
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
 #include "tracking/live/sim_camera.h"
+#include "tracking/live/tracker_estimator.h"
 #include "tracking/servo/head_servo.h"
 
 namespace linetrack {
@@ -28,7 +29,11 @@ struct ServoBenchOptions {
   double start_pan_offset = 0.17453292519943295;      // 10 deg
   double start_tilt_offset = 0.08726646259971647;     // 5 deg
   HeadServoOptions servo;
-  PoseJitterOptions jitter;  // stands in for a tracker's noise
+  // The poses: the tracker (rendered frames needed), or the simulator's truth with `jitter`
+  // standing in for a tracker's noise.
+  bool use_tracker = true;
+  TrackerEstimatorOptions tracker;
+  PoseJitterOptions jitter;
 
   bool Check(std::string* why) const;
 };
@@ -46,7 +51,10 @@ struct ServoBenchRun {
   double max_error_px = 0.0;
   std::vector<double> loop_ms;      // per iteration, capture excluded
   std::vector<double> estimate_ms;  // of which the pose estimate
-  std::vector<double> grab_ms;      // capture (rendering), not in loop_ms
+  int frames_with_pose = 0;
+  double max_position_error_m = 0.0;  // estimated pose against the truth (frames with a pose)
+  double max_rotation_error_deg = 0.0;
+  std::vector<double> grab_ms;  // capture (rendering), not in loop_ms
 };
 
 // Runs both scenarios on `model` with `camera` (its size is the frame size). `area` is needed
