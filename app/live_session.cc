@@ -67,7 +67,12 @@ LiveSession::LiveSession(const LivePlan& plan, const LiveInputs& inputs) {
 }
 
 void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
-  source_ = OpenFrameSource(plan.source_spec, FrameSourceOptions{});
+  // Cameras are set to the calibrated image size (and frame rate when asked).
+  FrameSourceOptions sources;
+  sources.aravis.width = inputs.camera.width;
+  sources.aravis.height = inputs.camera.height;
+  sources.aravis.frame_rate = plan.camera_fps;
+  source_ = OpenFrameSource(plan.source_spec, sources);
   head_ = OpenHead(plan.head_spec, HeadOptions{});
   const HeadGeometry geometry = GeometryOf(plan.head_model);
   const double crossing = CrossingHeightFor(geometry, plan.height);

@@ -32,6 +32,7 @@ struct LivePlan {
   LiveLoopOptions loop;
   std::optional<Eigen::Vector2d> head_start, head_start_offset;
   bool use_tracker = true;  // false: the simulator's truth
+  double camera_fps = 0.0;  // Aravis cameras: frame rate to set (0: keep the camera's)
   double duration = 0.0;    // seconds (simulated for sim); 0: until stopped
 };
 

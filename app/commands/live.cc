@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <exception>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -46,6 +47,7 @@ struct LiveCommandOptions {
   int snapshot_every = 30;
   bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
+  double camera_fps = 0.0;
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -132,6 +134,8 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
     throw InputError("--estimator: expected auto, tracker or truth, got '" + opt.estimator + "'");
   }
   plan.use_tracker = opt.estimator != "truth";
+  CheckRange(opt.camera_fps, 0.0, 1000.0, "--camera-fps");
+  plan.camera_fps = opt.camera_fps;
   if (!plan.sim) {
     if (!plan.use_tracker) throw InputError("--estimator truth: only with --source sim");
     if (!plan.prior && opt.prior_file.empty()) {
@@ -224,6 +228,7 @@ int RunLive(const LiveCommandOptions& opt) {
   LiveSummary summary;
   std::string stop_reason = "duration";
   HeadResult stopped;
+  std::exception_ptr failure;
   // Simulated time: the duration is a number of frames; real devices: wall-clock seconds. 0: until
   // stopped (or the end of a recorded source).
   const std::int64_t max_frames = plan.sim ? std::llround(plan.duration * plan.sim_camera.fps) : 0;
@@ -232,42 +237,50 @@ int RunLive(const LiveCommandOptions& opt) {
                             std::chrono::duration<double>(plan.duration));
   {
     StopSignals signals;
-    while (true) {
-      if (StopSignals::Received() != 0) {
-        stop_reason = "signal " + StopSignals::ReceivedName();
-        break;
-      }
-      const LiveIteration it = loop.Step();
-      if (it.grab == FrameStatus::kEndOfStream) {
-        stop_reason = "end of stream";
-        break;
-      }
-      summary.Add(it);
-      if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
-        spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
-      }
-      output.Add(it, session.truth());
-      const bool snapshot =
-          opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
-      const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
-      if (snapshot || show) {
-        const vpImage<vpRGBa> overlay =
-            DrawLiveOverlay(loop.last_frame().image, it,
-                            it.estimate.has_pose()
-                                ? ProjectVisibleEdges(model, occlusion, *it.estimate.cam_from_world,
-                                                      camera.Undistorted())
-                                : no_edges,
-                            camera, loop.desired_px());
-        if (snapshot) output.Snapshot(it.frame, overlay);
-        if (show && !window_tried) {
-          window_tried = true;
-          std::string why;
-          if (!window.Open(overlay, &why)) spdlog::warn("--display: no window ({}): headless", why);
+    try {
+      while (true) {
+        if (StopSignals::Received() != 0) {
+          stop_reason = "signal " + StopSignals::ReceivedName();
+          break;
         }
-        if (window.is_open()) window.Show(overlay);
+        const LiveIteration it = loop.Step();
+        if (it.grab == FrameStatus::kEndOfStream) {
+          stop_reason = "end of stream";
+          break;
+        }
+        summary.Add(it);
+        if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
+          spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
+        }
+        output.Add(it, session.truth());
+        const bool snapshot =
+            opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
+        const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
+        if (snapshot || show) {
+          const vpImage<vpRGBa> overlay = DrawLiveOverlay(
+              loop.last_frame().image, it,
+              it.estimate.has_pose()
+                  ? ProjectVisibleEdges(model, occlusion, *it.estimate.cam_from_world,
+                                        camera.Undistorted())
+                  : no_edges,
+              camera, loop.desired_px());
+          if (snapshot) output.Snapshot(it.frame, overlay);
+          if (show && !window_tried) {
+            window_tried = true;
+            std::string why;
+            if (!window.Open(overlay, &why))
+              spdlog::warn("--display: no window ({}): headless", why);
+          }
+          if (window.is_open()) window.Show(overlay);
+        }
+        if (max_frames > 0 && summary.frames >= max_frames) break;
+        if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
       }
-      if (max_frames > 0 && summary.frames >= max_frames) break;
-      if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
+    } catch (const std::exception& e) {
+      // A failure in the middle of a run (a frame of the wrong size, a file that cannot be
+      // written): stop the head, complete the files, then report it.
+      failure = std::current_exception();
+      stop_reason = std::string("error: ") + e.what();
     }
     stopped = loop.SafeStop();  // the head first, then the files
     if (!stopped.ok()) spdlog::error("head: could not stop: {}", stopped.message);
@@ -280,6 +293,7 @@ int RunLive(const LiveCommandOptions& opt) {
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
   output.Finish(json);
+  if (failure) std::rethrow_exception(failure);
   std::cout << "live: " << summary.frames << " frames, " << summary.with_pose << " with a pose, "
             << "final error " << summary.final_error_px << " px, stopped by " << stop_reason
             << "; wrote " << opt.out << std::endl;
@@ -332,6 +346,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                   "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
+  cmd->add_option("--camera-fps", opt->camera_fps,
+                  "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {
     opt->duration_given = cmd->get_option("--duration")->count() > 0;
     *action = [opt] { return RunLive(*opt); };

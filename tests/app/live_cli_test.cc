@@ -216,6 +216,37 @@ TEST_F(LiveCli, RecordedFramesAndAPtuOverItsSerialLine) {
   EXPECT_EQ(sent[sent.size() - 3], "H");  // the safe stop at the end: H PS0 TS0
 }
 
+// Frames of another size than the camera file's: no pose is attempted, the head is kept still,
+// and the run fails (exit 1) with the reason in the head log.
+TEST_F(LiveCli, FramesOfTheWrongSizeKeepTheHeadStill) {
+  const fs::path sequence = dir_ / "sequence";
+  ASSERT_EQ(Linetrack("render --model " + kModel + " --camera " + kCamera +
+                      " --path hall-loop --frames 3 --out " + sequence.string())
+                .code,
+            0);
+  const fs::path small = dir_ / "small.xml";
+  std::string xml = ReadAll(kCamera);
+  xml.replace(xml.find("<image_width>640"), 16, "<image_width>800");
+  std::ofstream(small) << xml;
+  std::string why;
+  const std::unique_ptr<PtuEmulator> ptu = PtuEmulator::Start({}, &why);
+  ASSERT_TRUE(ptu) << why;
+  std::string err;
+  EXPECT_EQ(Live("--source " + (sequence / "frame_%05d.png").string() +
+                     " --head ptu:" + ptu->device_path() + " --model " + kModel + " --camera " +
+                     small.string() + " --prior 1.4,1.3,-40 --height 1.3 --out " + out_.string(),
+                 &err),
+            1)
+      << err;
+  const std::vector<std::string> rows = Lines(ReadAll(out_ / "frames.csv"));
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NE(rows[1].find("frame 640x480 but the camera is 800x480"), std::string::npos) << rows[1];
+  const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
+  EXPECT_EQ(summary["frames_with_pose"], 0);
+  const std::vector<std::string> sent = ptu->commands();
+  EXPECT_EQ(std::find(sent.begin(), sent.end(), "CV"), sent.end());  // never a velocity
+}
+
 // The simulator's truth as the estimator: the poses written are the true ones.
 TEST_F(LiveCli, TruthEstimatorWritesTheTruePoses) {
   std::string err;

@@ -145,6 +145,15 @@ LiveIteration LiveLoop::Step() {
   }
   it.frame = frame_.index;
   it.t = frame_.timestamp_s;
+  if (static_cast<int>(frame_.image.getWidth()) != camera_.width ||
+      static_cast<int>(frame_.image.getHeight()) != camera_.height) {
+    StopHead("frame " + std::to_string(frame_.image.getWidth()) + "x" +
+                 std::to_string(frame_.image.getHeight()) + " but the camera is " +
+                 std::to_string(camera_.width) + "x" + std::to_string(camera_.height),
+             &it);
+    it.loop_ms = MillisecondsSince(start);
+    return it;
+  }
 
   const HeadResult read = head_->Read(&it.head);
   it.head_read = read.ok();

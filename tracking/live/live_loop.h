@@ -51,7 +51,8 @@ enum class HeadCommand {
   kNone,      // nothing sent (the same command as before, or the head did not answer)
   kVelocity,  // servo rates
   kHold,      // zero rates: converged
-  kStop,      // safe stop: no frame, no pose, no target, no head reading, a refused command
+  kStop,  // safe stop: no frame (or one of the wrong size), no pose, no target, no head reading,
+          // a refused command
 };
 
 // "none", "velocity", "hold", "stop".
