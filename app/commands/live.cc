@@ -134,6 +134,11 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
     throw InputError("--estimator: expected auto, tracker or truth, got '" + opt.estimator + "'");
   }
   plan.use_tracker = opt.estimator != "truth";
+  if (plan.use_tracker && plan.head_model == HeadModel::kBiclops) {
+    throw InputError(
+        "--head-model biclops: its camera is upside down and the tracker's robot checks assume "
+        "an upright camera (roll 0); use --estimator truth with the simulator");
+  }
   CheckRange(opt.camera_fps, 0.0, 1000.0, "--camera-fps");
   plan.camera_fps = opt.camera_fps;
   if (!plan.sim) {
@@ -309,7 +314,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
       "Run live on a pan-tilt head, headless: grab frames, estimate the camera pose, servo the "
       "head to keep the target at the image centre, and log everything to --out");
   cmd->add_option("--source", opt->source,
-                  "aravis[:ID] | v4l2:/dev/videoN | sim[:key=value,...] (docs/live.md)")
+                  "aravis[:ID] | v4l2:/dev/videoN | sim[:key=value,...] | video or image sequence "
+                  "(docs/live.md)")
       ->required();
   cmd->add_option("--head", opt->head, "ptu:/dev/ttyUSB0 | sim")->required();
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
@@ -341,7 +347,9 @@ void AddLive(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_flag("--display", opt->display,
                 "Show the overlay of every frame in a window (X11); headless when none answers");
-  cmd->add_option("--nav", opt->nav_path, "Navigable-area file for sim:path=loop and clutter");
+  cmd->add_option("--nav", opt->nav_path,
+                  "Navigable-area file for the matcher, sim:path=loop and clutter (default: "
+                  "MODEL.nav.json, else derived from the walls)");
   cmd->add_option("--estimator", opt->estimator,
                   "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();

@@ -152,6 +152,7 @@ TEST_F(LiveCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {"--source v4l2:/dev/video9 --head ptu:/dev/ttyUSB0 --prior 3,1.5,20 --estimator truth",
        "only with --source sim"},
       {"--source sim --head sim --prior 3,1.5,20 --estimator magic", "--estimator"},
+      {"--source sim --head sim --prior 3,1.5,20 --head-model biclops", "upside down"},
   };
   for (const auto& [args, what] : cases) {
     std::string err;
