@@ -1,4 +1,5 @@
 #include "models/camera.h"
+#include "models/silence_stdout.h"
 
 #include <visp3/core/vpCameraParameters.h>
 #include <visp3/core/vpXmlParserCamera.h>
@@ -12,17 +13,6 @@
 
 namespace linetrack {
 namespace {
-
-// vpXmlParserCamera prints "Found camera with name ..." on stdout; keep stdout for our output.
-class SilenceStdout {
- public:
-  SilenceStdout() : saved_(std::cout.rdbuf(sink_.rdbuf())) {}
-  ~SilenceStdout() { std::cout.rdbuf(saved_); }
-
- private:
-  std::ostringstream sink_;
-  std::streambuf* saved_;
-};
 
 std::string ReadText(const std::string& path) {
   std::error_code ec;
@@ -144,7 +134,7 @@ CameraIntrinsics ReadCameraXml(const std::string& path, const std::string& name,
   if (!camera_name.empty()) {
     vpXmlParserCamera parser;
     vpCameraParameters params;
-    SilenceStdout quiet;
+    ScopedStdoutSilencer quiet;
     for (auto model : {vpCameraParameters::perspectiveProjWithDistortion,
                        vpCameraParameters::perspectiveProjWithoutDistortion}) {
       try {
@@ -193,7 +183,7 @@ void WriteCameraXml(const std::string& path, const CameraIntrinsics& plain,
   std::filesystem::remove(path, ec);  // save() would silently keep an existing camera
   vpXmlParserCamera parser;
   const unsigned w = static_cast<unsigned>(plain.width), h = static_cast<unsigned>(plain.height);
-  SilenceStdout quiet;
+  ScopedStdoutSilencer quiet;
   int status = parser.save(vpCameraParameters(plain.px, plain.py, plain.u0, plain.v0), path,
                            plain.name, w, h, additional_info);
   if (status == vpXmlParserCamera::SEQUENCE_OK && distorted) {

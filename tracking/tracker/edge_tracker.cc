@@ -1,4 +1,5 @@
 #include "tracking/tracker/edge_tracker.h"
+#include "models/silence_stdout.h"
 
 #include <visp3/core/vpEigenConversion.h>
 #include <visp3/core/vpException.h>
@@ -14,18 +15,6 @@
 namespace linetrack {
 
 namespace {
-
-// ViSP prints the content of every model it loads on std::cout; linetrack's library code does
-// not print, so that output is swallowed while a model loads.
-class ScopedCoutSilencer {
- public:
-  ScopedCoutSilencer() : saved_(std::cout.rdbuf(sink_.rdbuf())) {}
-  ~ScopedCoutSilencer() { std::cout.rdbuf(saved_); }
-
- private:
-  std::ostringstream sink_;
-  std::streambuf* saved_;
-};
 
 // ViSP's vpMeSite::NO_SUPPRESSION: a moving edge found and kept.
 constexpr double kGoodSiteState = 0.0;
@@ -50,7 +39,7 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
     throw InputError(Located(model_path, 0, "cannot read the model file"));
   }
   try {
-    ScopedCoutSilencer silence;
+    ScopedStdoutSilencer silence;
     tracker->loadModel(model_path, false);
   } catch (const vpException& e) {
     throw InputError(
