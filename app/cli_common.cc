@@ -1,7 +1,10 @@
 #include "app/cli_common.h"
 
 #include <unistd.h>
+
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,24 +14,30 @@
 
 namespace linetrack::app {
 
-Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
+std::vector<double> ParseNumberList(const std::string& text, size_t count, const std::string& flag,
+                                    const std::string& form) {
   std::stringstream in(text);
   std::string field;
-  double values[3];
-  int n = 0;
+  std::vector<double> values;
   while (std::getline(in, field, ',')) {
-    if (n >= 3) throw InputError(flag + ": expected X,Y,HEADING_DEG, got '" + text + "'");
+    if (values.size() >= count)
+      throw InputError(flag + ": expected " + form + ", got '" + text + "'");
     try {
       size_t used = 0;
-      values[n] = std::stod(field, &used);
-      if (used != field.size() || !std::isfinite(values[n])) throw std::invalid_argument(field);
+      values.push_back(std::stod(field, &used));
+      if (used != field.size() || !std::isfinite(values.back())) throw std::invalid_argument(field);
     } catch (const std::exception&) {
       throw InputError(flag + ": not a finite number: '" + field + "' in '" + text + "'");
     }
-    ++n;
   }
-  if (n != 3) throw InputError(flag + ": expected X,Y,HEADING_DEG, got '" + text + "'");
-  return {values[0], values[1], DegToRad(values[2])};
+  if (values.size() != count)
+    throw InputError(flag + ": expected " + form + ", got '" + text + "'");
+  return values;
+}
+
+Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
+  const std::vector<double> v = ParseNumberList(text, 3, flag, "X,Y,HEADING_DEG");
+  return {v[0], v[1], DegToRad(v[2])};
 }
 
 std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag) {
@@ -86,6 +95,45 @@ CLI::App* BenchGroup(CLI::App& cli) {
       "bench", "Benchmarks: accuracy and speed figures on this machine (see docs/)");
   bench->require_subcommand(1);
   return bench;
+}
+
+namespace {
+
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void RecordStopSignal(int signal) {
+  g_stop_signal = signal;
+}
+
+}  // namespace
+
+struct StopSignals::Saved {
+  struct sigaction old_int {};
+  struct sigaction old_term {};
+};
+
+StopSignals::StopSignals() : saved_(std::make_unique<Saved>()) {
+  g_stop_signal = 0;
+  struct sigaction action {};
+  action.sa_handler = RecordStopSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, &saved_->old_int);
+  sigaction(SIGTERM, &action, &saved_->old_term);
+}
+
+StopSignals::~StopSignals() {
+  sigaction(SIGINT, &saved_->old_int, nullptr);
+  sigaction(SIGTERM, &saved_->old_term, nullptr);
+}
+
+int StopSignals::Received() {
+  return g_stop_signal;
+}
+
+std::string StopSignals::ReceivedName() {
+  const int signal = g_stop_signal;
+  if (signal == 0) return "";
+  return signal == SIGINT ? "SIGINT" : "SIGTERM";
 }
 
 void EnsureDirectory(const std::string& dir) {

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,11 @@ constexpr int kExitBadInput = 2;   // bad usage or bad input (one line on stderr
 
 // What a chosen subcommand runs after parsing; returns the exit code.
 using CommandAction = std::function<int()>;
+
+// Parses `count` comma-separated finite numbers ("1.5,2,-3"); `form` names them in errors
+// (e.g. "X,Y,Z"). Throws InputError naming `flag` when malformed.
+std::vector<double> ParseNumberList(const std::string& text, size_t count, const std::string& flag,
+                                    const std::string& form);
 
 // Parses "X,Y,HEADING_DEG" (metres, metres, degrees) into a Pose3Dof with heading in radians.
 // Throws InputError naming `flag` when malformed or not finite.
@@ -35,6 +41,25 @@ void WriteFileAtomically(const std::string& path, const std::string& content);
 
 // The `bench` command group shared by the benchmarks (created by the first caller).
 CLI::App* BenchGroup(CLI::App& cli);
+
+// While an object lives, SIGINT and SIGTERM are recorded instead of ending the process, so that a
+// long run (replay, live) can stop cleanly; the previous handlers come back when it dies.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // The signal received since construction (SIGINT or SIGTERM), 0 for none.
+  static int Received();
+  // "SIGINT" or "SIGTERM" (empty for none).
+  static std::string ReceivedName();
+
+ private:
+  struct Saved;
+  std::unique_ptr<Saved> saved_;
+};
 
 // Creates `dir` (and parents) when missing; throws InputError when it cannot.
 void EnsureDirectory(const std::string& dir);

@@ -19,5 +19,7 @@ void AddLines(CLI::App& cli, CommandAction* action);
 void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
 void AddReplay(CLI::App& cli, CommandAction* action);
+void AddLive(CLI::App& cli, CommandAction* action);
+void AddBenchServo(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

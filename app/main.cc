@@ -56,6 +56,8 @@ int main(int argc, char** argv) {
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
   app::AddReplay(cli, &action);
+  app::AddLive(cli, &action);
+  app::AddBenchServo(cli, &action);
 
   try {
     cli.parse(argc, argv);

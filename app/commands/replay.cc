@@ -5,10 +5,8 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -39,32 +37,6 @@ struct ReplayOptions {
   long max_frames = 0;
   bool overlay_png = false, no_overlay = false, scanline = false;
   LineFlags lines;  // the line extractor of the re-localisation
-};
-
-std::atomic<int> g_signal{0};
-
-void OnSignal(int signal) {
-  g_signal = signal;
-}
-
-// SIGINT and SIGTERM set g_signal while a replay runs; the previous handlers come back after.
-class SignalGuard {
- public:
-  SignalGuard() {
-    struct sigaction action {};
-    action.sa_handler = OnSignal;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &old_int_);
-    sigaction(SIGTERM, &action, &old_term_);
-  }
-  ~SignalGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
 };
 
 double Milliseconds(Clock::duration d) {
@@ -274,8 +246,7 @@ int RunReplay(const ReplayOptions& opt) {
     WriteFileAtomically(opt.out + "/summary.json", ReplaySummary(records, info).dump(2) + "\n");
   };
 
-  SignalGuard signals;
-  g_signal = 0;
+  StopSignals signals;
   Progress progress(opt.max_frames > 0 ? opt.max_frames : s.source->FrameCount(),
                     spdlog::get_level() <= spdlog::level::info);
   std::vector<ReplayFrameRecord> records;
@@ -329,8 +300,8 @@ int RunReplay(const ReplayOptions& opt) {
       write_summary(records);
       last_summary = Clock::now();
     }
-    if (g_signal != 0) {
-      info.interruption = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+    if (StopSignals::Received() != 0) {
+      info.interruption = StopSignals::ReceivedName();
       break;
     }
     if (opt.max_frames > 0 && static_cast<long>(records.size()) >= opt.max_frames) {

@@ -226,6 +226,83 @@ TEST_F(PtuDriverTest, SilentUnitTimesOutAndRecovers) {
   EXPECT_NEAR(state.pan, 7 * kCountRad, kAngleTolRad);
 }
 
+// Error replies in the middle of a run are results naming the unit's message, nothing is
+// assumed done, and the line stays in step: the next exchange reads its own reply.
+TEST_F(PtuDriverTest, ErrorRepliesDuringARunAreResultsAndKeepTheLineInStep) {
+  emulator_->SetPositions(250, -100);
+  emulator_->RejectNextCommand("Illegal Command");
+  HeadState state;
+  HeadResult r = driver_->Read(&state);
+  EXPECT_EQ(r.status, HeadStatus::kRejected);
+  EXPECT_NE(r.message.find("Illegal Command"), std::string::npos) << r.message;
+  state = ReadState();
+  EXPECT_NEAR(state.pan, 250 * kCountRad, kAngleTolRad);
+  EXPECT_NEAR(state.tilt, 100 * kCountRad, kAngleTolRad);
+
+  // A refused switch to velocity mode: the driver stays in position mode and tries again.
+  emulator_->RejectNextCommand("Illegal Command");
+  r = driver_->SetVelocity(0.1, 0.0);
+  EXPECT_EQ(r.status, HeadStatus::kRejected);
+  EXPECT_EQ(ReadState().mode, HeadMode::kPosition);
+  ASSERT_TRUE(driver_->SetVelocity(0.1, 0.0).ok());
+  EXPECT_TRUE(emulator_->velocity_mode());
+  EXPECT_EQ(ReadState().mode, HeadMode::kVelocity);
+
+  // A refused velocity: the rate the driver reports is not the refused one.
+  emulator_->RejectNextCommand("Pan speed cannot exceed 2902 positions/sec");
+  r = driver_->SetVelocity(0.3, 0.0);
+  EXPECT_EQ(r.status, HeadStatus::kRejected);
+  EXPECT_NE(r.message.find("cannot exceed"), std::string::npos) << r.message;
+  EXPECT_NEAR(ReadState().pan_rate, 0.1, kCountRad);
+
+  // A refused position command.
+  emulator_->RejectNextCommand("Illegal Command Argument");
+  r = driver_->MoveTo(0.0, 0.0);
+  EXPECT_EQ(r.status, HeadStatus::kRejected);
+  ASSERT_TRUE(driver_->MoveTo(0.0, 0.0).ok());
+  emulator_->Advance(2.0);
+  EXPECT_NEAR(ReadState().pan, 0.0, kOneCountTolRad);
+  ASSERT_TRUE(driver_->Stop().ok());
+}
+
+// The exact joint limits are reachable (no count lost to rounding), and a limit error from the
+// unit itself (its limits differing from those it reported) comes back as a rejection.
+TEST_F(PtuDriverTest, ReachesTheExactLimitsAndReportsTheUnitsLimitErrors) {
+  const HeadLimits limits = driver_->Limits();
+  ASSERT_TRUE(driver_->MoveTo(limits.pan_max, limits.tilt_min).ok());
+  emulator_->Advance(5.0);
+  EXPECT_EQ(emulator_->pan_position(), 3090.0);
+  EXPECT_EQ(emulator_->tilt_position(), 604.0);  // looking up: positive counts on a D46
+  HeadState state = ReadState();
+  EXPECT_NEAR(state.pan, limits.pan_max, kAngleTolRad);
+  EXPECT_NEAR(state.tilt, limits.tilt_min, kAngleTolRad);
+  ASSERT_TRUE(driver_->MoveTo(limits.pan_min, limits.tilt_max).ok());
+  emulator_->Advance(10.0);
+  EXPECT_EQ(emulator_->pan_position(), -3090.0);
+  EXPECT_EQ(emulator_->tilt_position(), -907.0);
+  // The unit's limit error, as it words it, comes back as a rejection.
+  emulator_->RejectNextCommand("Maximum allowable Pan position is 3090");
+  const HeadResult r = driver_->MoveTo(limits.pan_max, 0.0);
+  EXPECT_EQ(r.status, HeadStatus::kRejected);
+  EXPECT_NE(r.message.find("Maximum allowable Pan position"), std::string::npos) << r.message;
+}
+
+// Pure velocity mode into the tilt limit: "!T" stops the axis and flags it; the pan keeps going.
+TEST_F(PtuDriverTest, TiltLimitEventInVelocityMode) {
+  emulator_->SetPositions(0, 550);                     // 54 counts below the upper tilt limit
+  ASSERT_TRUE(driver_->SetVelocity(0.05, -0.2).ok());  // tilting up: towards TX = 604
+  emulator_->Advance(0.5);
+  const HeadState state = ReadState();
+  EXPECT_TRUE(state.tilt_at_limit);
+  EXPECT_FALSE(state.pan_at_limit);
+  EXPECT_EQ(state.tilt_rate, 0.0);
+  EXPECT_NEAR(state.pan_rate, 0.05, kCountRad);
+  EXPECT_EQ(emulator_->tilt_position(), 604.0);
+  EXPECT_GT(emulator_->pan_position(), 0.0);
+  EXPECT_EQ(driver_->tilt_limit_events(), 1);
+  ASSERT_TRUE(driver_->Stop().ok());
+}
+
 // The same, without opening the driver in SetUp.
 class PtuDriverOpen : public PtuDriverTest {
  protected:

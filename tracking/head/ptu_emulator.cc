@@ -138,7 +138,12 @@ void PtuEmulator::Handle(const std::string& token, char delimiter) {
     if (options_.seconds_per_command > 0.0) AdvanceLocked(options_.seconds_per_command);
     if (!responsive_) return;
     if (echo_) out = token + delimiter;
-    out += Answer(command) + "\r\n";
+    if (!reject_next_.empty()) {  // a unit refusing a command: nothing is executed
+      out += "! " + reject_next_ + "\r\n";
+      reject_next_.clear();
+    } else {
+      out += Answer(command) + "\r\n";
+    }
   }
   Send(out);
 }
@@ -289,6 +294,11 @@ double PtuEmulator::time() const {
 void PtuEmulator::SetResponsive(bool responsive) {
   std::lock_guard<std::mutex> lock(mutex_);
   responsive_ = responsive;
+}
+
+void PtuEmulator::RejectNextCommand(const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  reject_next_ = message;
 }
 
 void PtuEmulator::Inject(const std::string& bytes) {

@@ -47,6 +47,9 @@ class PtuEmulator {
 
   // When false, commands are read and dropped without any reply (a hung unit).
   void SetResponsive(bool responsive);
+  // The next command received is answered "! <message>" and not executed (error replies in the
+  // middle of a run: a unit that refuses, a command garbled on the line).
+  void RejectNextCommand(const std::string& message);
   // Sends raw bytes to the host (noise, banners, unsolicited events).
   void Inject(const std::string& bytes);
 
@@ -91,6 +94,7 @@ class PtuEmulator {
   bool echo_ = true;
   bool verbose_ = true;
   bool responsive_ = true;
+  std::string reject_next_;
   double time_ = 0.0;
   std::vector<std::string> commands_;
 

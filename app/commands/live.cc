@@ -1,0 +1,365 @@
+// `linetrack live`: run on a pan-tilt head, headless.
+//   linetrack live --source aravis[:ID]|v4l2:/dev/videoN|sim[:ARGS] --head ptu:/dev/ttyUSB0|sim
+//                  --model M.cao --camera C.xml [--prior X,Y,HEADING | --prior-file F.csv]
+//                  --height H [--target X,Y,Z] [--target-pixel U,V] --out DIR [--duration S]
+// Each frame: grab, read the head, estimate the camera pose (the robot's prior: heading = base
+// heading + pan, tilt from the head), servo the head onto the target, log. SIGINT/SIGTERM stop
+// the head first, then the files are completed. Outputs: app/live_output.h, docs/live.md.
+#include <spdlog/spdlog.h>
+#include <visp3/core/vpException.h>
+#include <visp3/gui/vpDisplayX.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "app/commands.h"
+#include "app/live_output.h"
+#include "app/live_session.h"
+#include "app/localize_image.h"
+#include "models/errors.h"
+#include "models/geometry.h"
+#include "models/trajectory_io.h"
+#include "tracking/capture/source_factory.h"
+#include "tracking/head/head_factory.h"
+#include "tracking/live/live_overlay.h"
+#include "tracking/live/servo_bench.h"
+#include "tracking/tracker/track_bench.h"
+
+namespace linetrack::app {
+namespace {
+
+struct LiveCommandOptions {
+  std::string source, head, model_path, camera_path, out;
+  std::string prior, prior_file, target, target_pixel, nav_path;
+  std::string head_start, head_start_offset;
+  std::string head_model = "ptu46";
+  std::string estimator = "auto";
+  std::string settings;
+  double height = -1.0;
+  double duration = 0.0;
+  bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
+  int snapshot_every = 30;
+  bool display = false;
+  double max_rate_deg = 57.29577951308232;  // 1 rad/s
+  double camera_fps = 0.0;
+};
+
+// A window showing the overlay of every frame (X11 through ViSP), when a display answers.
+class LiveWindow {
+ public:
+  // Opens the window on the first image; false (headless) with *why when there is no display.
+  bool Open(const vpImage<vpRGBa>& first, std::string* why) {
+    if (std::getenv("DISPLAY") == nullptr || *std::getenv("DISPLAY") == '\0') {
+      *why = "DISPLAY is not set";
+      return false;
+    }
+    image_ = first;
+    try {
+      display_ = std::make_unique<vpDisplayX>();
+      display_->init(image_, -1, -1, "linetrack live");
+    } catch (const vpException& e) {
+      display_.reset();
+      *why = e.getMessage();
+      return false;
+    }
+    return true;
+  }
+  bool is_open() const { return display_ != nullptr; }
+  void Show(const vpImage<vpRGBa>& image) {
+    image_ = image;
+    vpDisplay::display(image_);
+    vpDisplay::flush(image_);
+  }
+
+ private:
+  vpImage<vpRGBa> image_;
+  std::unique_ptr<vpDisplayX> display_;
+};
+
+// Every flag checked before any file is read, device opened or output written.
+LivePlan CheckFlags(const LiveCommandOptions& opt) {
+  LivePlan plan;
+  plan.source_spec = opt.source;
+  plan.head_spec = opt.head;
+  const SourceSpec source = ParseSourceSpec(opt.source);
+  const HeadSpec head = ParseHeadSpec(opt.head);
+  plan.sim = source.kind == SourceKind::kSim;
+  if (plan.sim != (head.kind == HeadKind::kSim)) {
+    throw InputError("--source " + opt.source + " --head " + opt.head +
+                     ": the simulated camera and the simulated head go together");
+  }
+  if (!ParseHeadModel(opt.head_model, &plan.head_model)) {
+    throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
+  }
+  CheckRange(opt.height, 0.05, 100.0, "--height");
+  plan.height = opt.height;
+  if (!opt.prior.empty() && !opt.prior_file.empty()) {
+    throw InputError("--prior and --prior-file: give one of them");
+  }
+  if (!opt.prior.empty()) plan.prior = ParsePrior(opt.prior, "--prior");
+  if (!opt.target.empty()) {
+    const std::vector<double> v = ParseNumberList(opt.target, 3, "--target", "X,Y,Z");
+    plan.loop.target = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (!opt.target_pixel.empty()) {
+    const std::vector<double> v = ParseNumberList(opt.target_pixel, 2, "--target-pixel", "U,V");
+    plan.loop.desired_px = Eigen::Vector2d(v[0], v[1]);
+  }
+  if (!opt.head_start.empty() && !opt.head_start_offset.empty()) {
+    throw InputError("--head-start and --head-start-offset: give one of them");
+  }
+  if (!opt.head_start.empty()) {
+    const auto v = ParseNumberList(opt.head_start, 2, "--head-start", "PAN_DEG,TILT_DEG");
+    plan.head_start = Eigen::Vector2d(DegToRad(v[0]), DegToRad(v[1]));
+  }
+  if (!opt.head_start_offset.empty()) {
+    if (!plan.loop.target) throw InputError("--head-start-offset: needs --target");
+    const auto v =
+        ParseNumberList(opt.head_start_offset, 2, "--head-start-offset", "PAN_DEG,TILT_DEG");
+    plan.head_start_offset = Eigen::Vector2d(DegToRad(v[0]), DegToRad(v[1]));
+  }
+  if (opt.snapshot_every < 0) throw InputError("--snapshot-every: must be >= 0");
+  CheckRange(opt.max_rate_deg, 0.1, 360.0, "--max-rate");
+  plan.loop.servo.model = plan.head_model;
+  plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
+  plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
+  CheckRange(plan.duration, 0.0, 1e7, "--duration");
+  if (opt.estimator != "auto" && opt.estimator != "tracker" && opt.estimator != "truth") {
+    throw InputError("--estimator: expected auto, tracker or truth, got '" + opt.estimator + "'");
+  }
+  plan.use_tracker = opt.estimator != "truth";
+  if (plan.use_tracker && plan.head_model == HeadModel::kBiclops) {
+    throw InputError(
+        "--head-model biclops: its camera is upside down and the tracker's robot checks assume "
+        "an upright camera (roll 0); use --estimator truth with the simulator");
+  }
+  CheckRange(opt.camera_fps, 0.0, 1000.0, "--camera-fps");
+  plan.camera_fps = opt.camera_fps;
+  if (!plan.sim) {
+    if (!plan.use_tracker) throw InputError("--estimator truth: only with --source sim");
+    if (!plan.prior && opt.prior_file.empty()) {
+      throw InputError("--prior or --prior-file: the matcher needs the robot's prior");
+    }
+    return plan;
+  }
+  plan.sim_camera.head_model = plan.head_model;
+  plan.sim_camera.camera_height = opt.height;
+  ParseSimArguments(source.argument, &plan.sim_camera);
+  if (plan.sim_camera.path == SimPath::kLoop && plan.prior) {
+    throw InputError("--prior: the simulated robot drives the loop (sim:path=loop); leave it out");
+  }
+  if (plan.sim_camera.path == SimPath::kStill && !plan.prior) {
+    throw InputError("--prior: the simulated robot stands at the prior X,Y,HEADING; give it");
+  }
+  if (!opt.prior_file.empty()) {
+    throw InputError("--prior-file: the simulated robot has its own odometry; leave it out");
+  }
+  if (plan.prior) plan.sim_camera.still_base = *plan.prior;
+  return plan;
+}
+
+nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop_reason) {
+  const double p50 = Quantile(s.loop_ms, 0.5), p95 = Quantile(s.loop_ms, 0.95);
+  return {
+      {"stop_reason", stop_reason},
+      {"interrupted", stop_reason.rfind("signal", 0) == 0},
+      {"iterations", s.iterations},
+      {"frames", s.frames},
+      {"seconds", s.last_t - s.start_t},
+      {"frames_with_pose", s.with_pose},
+      {"frames_without_pose", s.without_pose},
+      {"losses", s.losses},
+      {"recoveries", s.recoveries},
+      {"timeouts", s.timeouts},
+      {"device_lost", s.device_lost},
+      {"head_errors", s.head_errors},
+      {"head_stops", s.stops},
+      {"converged_frames", s.converged_frames},
+      {"first_convergence_s", s.first_convergence_t < 0 ? -1.0 : s.first_convergence_t - s.start_t},
+      {"final_error_px", s.final_error_px},
+      {"max_error_after_convergence_px", s.max_error_after_convergence_px},
+      {"saturated_frames", s.saturated_frames},
+      {"limited_frames", s.limited_frames},
+      {"max_cmd_pan_rate_deg_s", RadToDeg(s.max_abs_pan_rate)},
+      {"max_cmd_tilt_rate_deg_s", RadToDeg(s.max_abs_tilt_rate)},
+      {"pan_range_deg", {RadToDeg(s.pan_min), RadToDeg(s.pan_max)}},
+      {"tilt_range_deg", {RadToDeg(s.tilt_min), RadToDeg(s.tilt_max)}},
+      {"loop_ms_median", p50},
+      {"loop_ms_p95", p95}};
+}
+
+int RunLive(const LiveCommandOptions& opt) {
+  const LivePlan plan = CheckFlags(opt);
+  LiveInputs inputs;
+  inputs.camera = ReadCameraXml(opt.camera_path);
+  if (inputs.camera.width <= 0) {
+    throw InputError(opt.camera_path + ": the camera file gives no image size");
+  }
+  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  for (const std::string& w : model.warnings())
+    spdlog::warn("{}", w);
+  inputs.model = &model;
+  if (!opt.prior_file.empty()) inputs.priors = ReadPriors(opt.prior_file);
+  if (!opt.prior_file.empty() && inputs.priors.empty()) {
+    throw InputError(opt.prior_file + ": no prior rows");
+  }
+  inputs.tracker.matcher = DetectedLineMatcherOptions({});
+  if (!opt.settings.empty()) inputs.tracker.settings = ReadTrackerSettings(opt.settings);
+  std::optional<NavigableArea> area;
+  if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
+      plan.sim_camera.render_options.scene.clutter > 0) {
+    NavigableAreaOptions area_options;
+    area_options.sidecar_path = opt.nav_path;
+    area = NavigableArea::FromModel(model, area_options);
+    inputs.area = &*area;
+  }
+  LiveSession session(plan, inputs);
+  LiveLoop& loop = session.loop();
+  const CameraIntrinsics& camera = inputs.camera;
+
+  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr);
+  spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
+               session.DescribeHead(), session.DescribeEstimator(), plan.duration);
+  const std::vector<ProjectedEdge> no_edges;
+  LiveWindow window;
+  bool window_tried = false;
+  const OcclusionTester occlusion(model);
+  LiveSummary summary;
+  std::string stop_reason = "duration";
+  HeadResult stopped;
+  std::exception_ptr failure;
+  // Simulated time: the duration is a number of frames; real devices: wall-clock seconds. 0: until
+  // stopped (or the end of a recorded source).
+  const std::int64_t max_frames = plan.sim ? std::llround(plan.duration * plan.sim_camera.fps) : 0;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(plan.duration));
+  {
+    StopSignals signals;
+    try {
+      while (true) {
+        if (StopSignals::Received() != 0) {
+          stop_reason = "signal " + StopSignals::ReceivedName();
+          break;
+        }
+        const LiveIteration it = loop.Step();
+        if (it.grab == FrameStatus::kEndOfStream) {
+          stop_reason = "end of stream";
+          break;
+        }
+        summary.Add(it);
+        if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
+          spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
+        }
+        output.Add(it, session.truth());
+        const bool snapshot =
+            opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
+        const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
+        if (snapshot || show) {
+          const vpImage<vpRGBa> overlay = DrawLiveOverlay(
+              loop.last_frame().image, it,
+              it.estimate.has_pose()
+                  ? ProjectVisibleEdges(model, occlusion, *it.estimate.cam_from_world,
+                                        camera.Undistorted())
+                  : no_edges,
+              camera, loop.desired_px());
+          if (snapshot) output.Snapshot(it.frame, overlay);
+          if (show && !window_tried) {
+            window_tried = true;
+            std::string why;
+            if (!window.Open(overlay, &why))
+              spdlog::warn("--display: no window ({}): headless", why);
+          }
+          if (window.is_open()) window.Show(overlay);
+        }
+        if (max_frames > 0 && summary.frames >= max_frames) break;
+        if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
+      }
+    } catch (const std::exception& e) {
+      // A failure in the middle of a run (a frame of the wrong size, a file that cannot be
+      // written): stop the head, complete the files, then report it.
+      failure = std::current_exception();
+      stop_reason = std::string("error: ") + e.what();
+    }
+    stopped = loop.SafeStop();  // the head first, then the files
+    if (!stopped.ok()) spdlog::error("head: could not stop: {}", stopped.message);
+  }
+  nlohmann::ordered_json json = SummaryJson(summary, stop_reason);
+  json["head_stopped_at_end"] = stopped.ok();
+  json["source"] = session.DescribeSource();
+  json["head"] = session.DescribeHead();
+  json["estimator"] = session.DescribeEstimator();
+  if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
+  json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
+  output.Finish(json);
+  if (failure) std::rethrow_exception(failure);
+  std::cout << "live: " << summary.frames << " frames, " << summary.with_pose << " with a pose, "
+            << "final error " << summary.final_error_px << " px, stopped by " << stop_reason
+            << "; wrote " << opt.out << std::endl;
+  return summary.with_pose > 0 ? kExitOk : kExitJobFailed;
+}
+
+}  // namespace
+
+void AddLive(CLI::App& cli, CommandAction* action) {
+  auto opt = std::make_shared<LiveCommandOptions>();
+  CLI::App* cmd = cli.add_subcommand(
+      "live",
+      "Run live on a pan-tilt head, headless: grab frames, estimate the camera pose, servo the "
+      "head to keep the target at the image centre, and log everything to --out");
+  cmd->add_option("--source", opt->source,
+                  "aravis[:ID] | v4l2:/dev/videoN | sim[:key=value,...] | video or image sequence "
+                  "(docs/live.md)")
+      ->required();
+  cmd->add_option("--head", opt->head, "ptu:/dev/ttyUSB0 | sim")->required();
+  cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
+  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (with its image size)")
+      ->required();
+  cmd->add_option("--height", opt->height, "Camera height above the floor, head level (metres)")
+      ->required();
+  cmd->add_option("--out", opt->out, "Output folder")->required();
+  cmd->add_option(
+      "--prior", opt->prior,
+      "Robot base position and heading X,Y,HEADING_DEG (the camera heading adds the pan)");
+  cmd->add_option("--prior-file", opt->prior_file,
+                  "Base odometry CSV t,x,y,heading_deg,height,tilt_deg (t from the first frame)");
+  cmd->add_option("--target", opt->target,
+                  "World point X,Y,Z to keep in view (default: centroid of the visible model)");
+  cmd->add_option("--target-pixel", opt->target_pixel,
+                  "Pixel U,V to bring the target to (default: the principal point)");
+  cmd->add_option("--duration", opt->duration,
+                  "Seconds to run (simulated seconds for sim; default 10 for sim, until Ctrl-C)");
+  cmd->add_option("--head-model", opt->head_model, "Head kinematics: ptu46 | biclops")
+      ->capture_default_str();
+  cmd->add_option("--head-start", opt->head_start, "Move the head to PAN_DEG,TILT_DEG first");
+  cmd->add_option("--head-start-offset", opt->head_start_offset,
+                  "Start the head PAN_DEG,TILT_DEG away from looking at --target");
+  cmd->add_option("--max-rate", opt->max_rate_deg, "Servo joint speed limit (deg/s)")
+      ->capture_default_str();
+  cmd->add_option("--snapshot-every", opt->snapshot_every,
+                  "Overlay snapshot every N frames into DIR/snapshots (0: none)")
+      ->capture_default_str();
+  cmd->add_flag("--display", opt->display,
+                "Show the overlay of every frame in a window (X11); headless when none answers");
+  cmd->add_option("--nav", opt->nav_path,
+                  "Navigable-area file for the matcher, sim:path=loop and clutter (default: "
+                  "MODEL.nav.json, else derived from the walls)");
+  cmd->add_option("--estimator", opt->estimator,
+                  "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
+      ->capture_default_str();
+  cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
+  cmd->add_option("--camera-fps", opt->camera_fps,
+                  "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
+  cmd->callback([opt, action, cmd] {
+    opt->duration_given = cmd->get_option("--duration")->count() > 0;
+    *action = [opt] { return RunLive(*opt); };
+  });
+}
+
+}  // namespace linetrack::app
