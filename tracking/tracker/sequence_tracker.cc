@@ -64,8 +64,8 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
     *why = "projection error jump: ratio > 1, floor >= 0, window >= 1";
     return false;
   }
-  if (!(prediction_min_px >= 0.0) || !(prediction_depth_m > 0.0)) {
-    *why = "prediction threshold must be >= 0 px and its depth > 0 m";
+  if (!(prediction_min_px >= 0.0)) {
+    *why = "prediction threshold must be >= 0 px";
     return false;
   }
   return true;
@@ -186,10 +186,11 @@ void SequenceTracker::MaybePredict(const std::optional<RobotReading>& robot, Fra
   const Eigen::Isometry3d predicted =
       PredictFromOdometry(last_good_->cam_from_world, WithReading(*then.odometry, then),
                           WithReading(*robot->odometry, *robot));
-  const PoseDifference move = ComparePoses(predicted, last_good_->cam_from_world);
-  const double shift_px =
-      tracker_->camera().px * (move.rotation + move.translation / options_.prediction_depth_m);
-  if (shift_px <= options_.prediction_min_px) return;
+  // The model's own image motion: driving forward or at a distance moves the image little.
+  if (tracker_->ImageMotionPx(last_good_->cam_from_world, predicted) <=
+      options_.prediction_min_px) {
+    return;
+  }
   // Aligned on the edges when they are found, else started from the prediction as it is.
   if (!tracker_->StartFromPrediction(*undistorted_, predicted, Known(robot)).ok) {
     tracker_->Start(*undistorted_, predicted);
@@ -208,8 +209,11 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   if (following_) {
     const Clock::time_point track_start = Clock::now();
     MaybePredict(robot, &report);
+    report.predict_ms = MillisecondsSince(track_start);
     const EdgeTrackResult result = tracker_->Track(*undistorted_, false, Known(robot));
     report.track_ms = MillisecondsSince(track_start);
+    report.passes_ms = result.passes_ms;
+    report.measure_ms = result.measure_ms;
     report.health = result.health;
     report.health_measured = result.ok;
     const std::string problem = Judge(result, t, robot);

@@ -49,10 +49,9 @@ struct SequenceTrackerOptions {
   // A restart from the last good pose is tried only this many frames after it (the camera moves).
   int restart_window = 30;
   // With odometry, the last pose is moved by the odometry's motion since the last frame and
-  // aligned on the image edges before tracking when that motion shifts the image by more than
-  // prediction_min_px (estimated for scene points prediction_depth_m away).
+  // aligned on the image edges before tracking when that motion moves the model's image by more
+  // than prediction_min_px (RMS over the model edges in view, RmsImageMotionPx).
   double prediction_min_px = 3.0;
-  double prediction_depth_m = 2.0;
   // A jump of the projection error to more than jump_ratio times its median over the last
   // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
   // (e.g. a door casing beside the modelled edge): the pose is dropped.
@@ -83,7 +82,10 @@ struct FrameReport {
   int lines = -1;      // segments extracted when the matcher ran, else -1
   bool predicted = false;  // tracking started from the odometry's prediction
   double undistort_ms = 0.0;
-  double track_ms = 0.0;       // tracking from the previous frame
+  double track_ms = 0.0;       // tracking from the previous frame, of which:
+  double predict_ms = 0.0;     //   the odometry's prediction and its alignment on the edges
+  double passes_ms = 0.0;      //   ViSP's track() passes
+  double measure_ms = 0.0;     //   moving-edge states and sub-pixel refinement
   double relocalize_ms = 0.0;  // matcher, restarts and their verification
   double total_ms = 0.0;
 };
