@@ -71,7 +71,9 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
                     {"replay_fps", r.replay_fps},
                     {"passes_per_frame", r.replay_passes},
                     {"visp_tracked", r.visp_tracked},
-                    {"linetrack_tracked", r.linetrack_tracked}});
+                    {"linetrack_tracked", r.linetrack_tracked},
+                    {"passes_ms_median", Quantile(r.passes_ms, 0.5)},
+                    {"measure_ms_median", Quantile(r.measure_ms, 0.5)}});
     if (!opt.json) {
       std::cout << std::left << std::setw(23) << r.name << std::right << std::setw(6) << r.frames
                 << std::setw(8) << visp_median << std::setw(7) << Quantile(r.visp_ms, 0.9)
@@ -79,7 +81,10 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
                 << Quantile(r.linetrack_ms, 0.9) << std::setw(7) << ours_cpu << std::setw(8)
                 << ratio << std::setw(8) << std::setprecision(0) << r.replay_fps
                 << std::setprecision(2) << std::setw(8) << r.replay_passes << "  " << r.visp_tracked
-                << "/" << r.linetrack_tracked << "\n";
+                << "/" << r.linetrack_tracked << "\n"
+                << "    linetrack stages, wall medians: ViSP passes " << Quantile(r.passes_ms, 0.5)
+                << " ms, moving-edge states and refinement " << Quantile(r.measure_ms, 0.5)
+                << " ms\n";
     }
   }
   std::error_code ec;
