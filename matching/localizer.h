@@ -92,6 +92,9 @@ class Localizer {
 
   const CameraIntrinsics& camera() const { return camera_; }
   const LocalizerOptions& options() const { return options_; }
+  const WireframeModel& model() const { return model_; }
+  const NavigableArea* area() const { return area_; }
+  const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
   // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity

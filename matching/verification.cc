@@ -168,12 +168,22 @@ void Score(const VerificationContext& context, const VerificationOptions& option
   result->score_px =
       PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->plausible = relative / n <= 1.0 && InsidePrior(context, result->pose, options) &&
-                      result->matched_edges >= options.min_matches &&
-                      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
-                      r.position_sigma_m <= options.max_position_sigma_m &&
-                      std::abs(r.focal_scale - 1.0) <= 3.0 * options.refinement.focal_prior_sigma &&
-                      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  result->implausible_because.clear();
+  if (relative / n > 1.0) {
+    result->implausible_because = "mean distance";
+  } else if (!InsidePrior(context, result->pose, options)) {
+    result->implausible_because = "outside the prior";
+  } else if (result->matched_edges < options.min_matches) {
+    result->implausible_because = "too few edges";
+  } else if (r.rms_px > std::hypot(options.max_rms_px, 0.5 * allowance / n)) {
+    result->implausible_because = "rms";
+  } else if (r.position_sigma_m > options.max_position_sigma_m ||
+             r.heading_sigma_rad > DegToRad(options.max_heading_sigma_deg)) {
+    result->implausible_because = "unobservable";
+  } else if (std::abs(r.focal_scale - 1.0) > 3.0 * options.refinement.focal_prior_sigma) {
+    result->implausible_because = "focal scale";
+  }
+  result->plausible = result->implausible_because.empty();
 }
 
 }  // namespace

@@ -86,7 +86,8 @@ struct VerifiedPose {
   double mean_distance_px = 0.0;  // mean eq. 9 distance over the pairs
   double score_px = 0.0;          // eq. 10 partial Hausdorff distance (k = min_matches)
   PoseRefinementResult refinement;
-  bool plausible = false;  // passed the RMS and observability checks
+  bool plausible = false;           // passed the RMS and observability checks
+  std::string implausible_because;  // the first check that failed (empty when plausible)
 };
 
 // The pose of a hypothesis (pairs of edge/line indices) by Levenberg-Marquardt from each of the
