@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "matching/observed_line.h"
+#include "models/robot_pose.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -132,5 +133,12 @@ HeadingInterval InscribedAngleRange(const Eigen::Vector2d& foot1, const Eigen::V
 // w_2 - w_1 within `range` (InscribedAngleRange of the feet) widened by the noise.
 bool BinaryVertical(const ObservedLine& line1, const ObservedLine& line2,
                     const HeadingInterval& range, double sigmas);
+
+// Minimal poses from two correspondences at known height: the headings solving the direction
+// constraint of a non-vertical one (up to two), then the position where both position lines
+// cross. Empty when both edges are vertical or the lines are parallel.
+std::vector<Pose3Dof> MinimalPoses(const ObservedLine& line1, const MatchEdge& edge1,
+                                   const ObservedLine& line2, const MatchEdge& edge2,
+                                   double height);
 
 }  // namespace linetrack

@@ -146,11 +146,10 @@ TruthDiagnosis DiagnoseTruth(const Localizer& localizer, const LocalizationProbl
   prior.focal_px = gate.focal_px;
   VerificationContext context{&edges,         &lines,           &camera,
                               problem.height, problem.tilt,     &localizer.occlusion(),
-                              &prior,         localizer.area(), options.noise.focal_relative};
+                              &prior,         localizer.area(), options.noise};
   VerificationOptions vo = options.verification;
   if (vo.refinement.focal_prior_sigma == 0.0) {
     vo.refinement.focal_prior_sigma = options.noise.focal_relative;
-    vo.refinement.prior_pixel_sigma = std::max(options.noise.offset_px, 0.5);
   }
   std::vector<std::pair<int, int>> all_true;
   for (const auto& [edge_id, line_index] : truth_matches) {
@@ -165,8 +164,9 @@ TruthDiagnosis DiagnoseTruth(const Localizer& localizer, const LocalizationProbl
     out.implausible_because = verified.implausible_because;
     out.matched_edges = verified.matched_edges;
     out.rms_px = verified.refinement.rms_px;
-    out.evidence_score =
-        Evidence(context, localizer.model(), localizer.occlusion(), verified, vo).Score();
+    VerifiedPose completed = verified;
+    CompleteEvidence(context, vo, &completed);
+    out.evidence_score = completed.evidence.Score();
     const std::set<std::pair<int, int>> kept(verified.pairs.begin(), verified.pairs.end());
     for (TruthPairCheck& check : out.pairs) {
       if (!index_of_edge.count(check.edge_id)) continue;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace linetrack {
 namespace {
@@ -124,6 +125,37 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
   return region;
 }
 
+bool FeasibleRegion::Contains(const Pose3Dof& pose) const {
+  const Eigen::Vector2d q(pose.x, pose.y);
+  for (const HeadingBin& bin : bins) {
+    const double h = pose.heading + 2.0 * kPi * std::round((bin.lo - pose.heading) / (2.0 * kPi));
+    if (h < bin.lo || h > bin.hi || bin.positions.Empty()) continue;
+    bool inside = true;
+    const Eigen::Vector2d* v = bin.positions.begin();
+    const int n = bin.positions.size();
+    for (int i = 0; i < n && inside; ++i)
+      inside = Cross2(v[(i + 1) % n] - v[i], q - v[i]) >= 0.0;
+    if (inside) return true;
+  }
+  return false;
+}
+
+bool FeasibleRegion::Within(const Pose3Dof& pose, double radius, double heading_margin) const {
+  if (bins.empty()) return false;
+  const double r2 = radius * radius;
+  const Eigen::Vector2d q(pose.x, pose.y);
+  for (const HeadingBin& bin : bins) {
+    if (std::abs(WrapAngle(bin.lo - pose.heading)) > heading_margin ||
+        std::abs(WrapAngle(bin.hi - pose.heading)) > heading_margin) {
+      return false;
+    }
+    for (const Eigen::Vector2d& v : bin.positions) {
+      if ((v - q).squaredNorm() > r2) return false;
+    }
+  }
+  return true;
+}
+
 void FeasibleRegion::Refine(int max_bins, double min_width) {
   while (!bins.empty() && 2 * static_cast<int>(bins.size()) <= max_bins &&
          bins.front().hi - bins.front().lo > 2.0 * min_width) {
@@ -153,6 +185,84 @@ std::vector<Pose3Dof> FeasibleRegion::Representatives() const {
   return poses;
 }
 
+namespace {
+
+// The band of positions a non-vertical correspondence allows in `bin`: |s(q)| <= half_width with
+// s the signed distance to the unit position line at the bin's mid heading, widened by how far
+// the line moves within the bin (its offset is affine in the position, so the polygon's vertices
+// bound the change).
+struct Band {
+  Eigen::Vector2d normal;
+  double offset = 0.0;  // s(q) = normal . q + offset
+  double half_width = 0.0;
+};
+
+Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                     const HeadingBin& bin) {
+  const Eigen::Vector2d centre = bin.positions.Centroid();
+  const Eigen::Vector3d p =
+      ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
+  const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
+  const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
+  const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
+  double slack = 0.0;
+  for (const Eigen::Vector2d& q : bin.positions) {
+    const double s = SignedDistance(mid, q);
+    slack =
+        std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
+  }
+  return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
+          PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas) + slack};
+}
+
+// The wedge of camera positions a vertical correspondence allows in `bin`: n1 . q + d1 >= 0 and
+// n2 . q + d2 >= 0; false when the bin is too wide for a wedge (everything allowed).
+bool VerticalWedge(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
+                   double* d2) {
+  const double margin = sigmas * line.bearing_sigma;
+  if (bin.hi - bin.lo + 2.0 * margin >= kPi) return false;
+  // Camera directions from the foot: (h - w) + pi for h in the bin, widened by the margin:
+  // from bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
+  const Eigen::Vector2d a = Trig(-line.bearing - margin + kPi),
+                        b = Trig(-line.bearing + margin + kPi);
+  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+  };
+  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a), u2 = rotate(bin.trig_hi, b);
+  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+  *d1 = -n1->dot(edge.foot);
+  *d2 = -n2->dot(edge.foot);
+  return true;
+}
+
+// Quick reject of a vertical correspondence: the directions from the foot to the region's
+// bounding box must meet the camera directions the headings allow.
+bool VerticalMayMeet(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                     const FeasibleRegion& in) {
+  const double margin = sigmas * line.bearing_sigma;
+  if (in.Empty() || in.Heading().Width() + 2.0 * margin >= kPi) return !in.Empty();
+  Eigen::Vector2d lo = *in.bins.front().positions.begin(), hi = lo;
+  for (const HeadingBin& bin : in.bins) {
+    for (const Eigen::Vector2d& q : bin.positions) {
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+  }
+  const Eigen::Vector2d centre = 0.5 * (lo + hi);
+  const double reach = 0.5 * (hi - lo).norm();
+  const Eigen::Vector2d to_box = centre - edge.foot;
+  const double distance = to_box.norm();
+  if (distance <= reach) return true;
+  const double spread = std::asin(reach / distance);
+  const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
+  const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
+  return offset <= spread + 0.5 * in.Heading().Width() + margin;
+}
+
+}  // namespace
+
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
@@ -161,75 +271,66 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
       DirectionIntervals(line, edge.dir, in.Heading(), sigmas);
   for (const HeadingBin& bin : in.bins) {
     if (!Overlaps(bin, parts)) continue;
-    const Eigen::Vector2d centre = bin.positions.Centroid();
-    const Eigen::Vector3d p =
-        ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
-    const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
-    const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
-    const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
-    // The line moves within the bin: its offset is affine in the position, so the polygon's
-    // vertices bound the change.
-    double slack = 0.0;
-    for (const Eigen::Vector2d& q : bin.positions) {
-      const double s = SignedDistance(mid, q);
-      slack = std::max(
-          {slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
-    }
-    const double half_width =
-        PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas) + slack;
+    const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
     // |s(q)| <= half_width: two half-planes of the unit line.
-    const Eigen::Vector2d n(mid.x(), mid.y());
     HeadingBin& cut = Append(bin, out);
-    cut.positions.ClipFrom(bin.positions, -n, half_width - mid.z(), n, half_width + mid.z());
+    cut.positions.ClipFrom(bin.positions, -band.normal, band.half_width - band.offset, band.normal,
+                           band.half_width + band.offset);
     if (cut.positions.Empty()) out->bins.pop_back();
   }
   return !out->Empty();
 }
 
+bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                      const FeasibleRegion& region) {
+  if (region.Empty()) return false;
+  const std::vector<HeadingInterval> parts =
+      DirectionIntervals(line, edge.dir, region.Heading(), sigmas);
+  if (parts.empty()) return false;
+  for (const HeadingBin& bin : region.bins) {
+    if (!Overlaps(bin, parts)) continue;
+    const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Eigen::Vector2d& q : bin.positions) {
+      const double s = band.normal.dot(q) + band.offset;
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    if (hi >= -band.half_width && lo <= band.half_width) return true;
+  }
+  return false;
+}
+
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
-  const double margin = sigmas * line.bearing_sigma;
-  // Camera directions from the foot: (h - w) + pi for h in the bin, widened by the margin:
-  // from bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
-  const Eigen::Vector2d a = Trig(-line.bearing - margin + kPi),
-                        b = Trig(-line.bearing + margin + kPi);
-  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-  };
-  // Quick reject: the directions from the foot to the region's bounding box must meet the
-  // camera directions the headings allow.
-  if (!in.Empty() && in.Heading().Width() + 2.0 * margin < kPi) {
-    Eigen::Vector2d lo = *in.bins.front().positions.begin(), hi = lo;
-    for (const HeadingBin& bin : in.bins) {
-      for (const Eigen::Vector2d& q : bin.positions) {
-        lo = lo.cwiseMin(q);
-        hi = hi.cwiseMax(q);
-      }
-    }
-    const Eigen::Vector2d centre = 0.5 * (lo + hi);
-    const double reach = 0.5 * (hi - lo).norm();
-    const Eigen::Vector2d to_box = centre - edge.foot;
-    const double distance = to_box.norm();
-    if (distance > reach) {
-      const double spread = std::asin(reach / distance);
-      const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
-      const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
-      if (offset > spread + 0.5 * in.Heading().Width() + margin) return false;
-    }
-  }
+  if (!VerticalMayMeet(line, edge, sigmas, in)) return false;
   for (const HeadingBin& bin : in.bins) {
     HeadingBin& cut = Append(bin, out);
-    if (bin.hi - bin.lo + 2.0 * margin >= kPi) {
+    Eigen::Vector2d n1, n2;
+    double d1 = 0.0, d2 = 0.0;
+    if (!VerticalWedge(line, edge, sigmas, bin, &n1, &d1, &n2, &d2)) {
       cut.positions = bin.positions;
       continue;
     }
-    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a), u2 = rotate(bin.trig_hi, b);
-    const Eigen::Vector2d n1(-u1.y(), u1.x()), n2(u2.y(), -u2.x());
-    cut.positions.ClipFrom(bin.positions, n1, -n1.dot(edge.foot), n2, -n2.dot(edge.foot));
+    cut.positions.ClipFrom(bin.positions, n1, d1, n2, d2);
     if (cut.positions.Empty()) out->bins.pop_back();
   }
   return !out->Empty();
+}
+
+bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const FeasibleRegion& region) {
+  if (!VerticalMayMeet(line, edge, sigmas, region)) return false;
+  ConvexPolygon scratch;
+  for (const HeadingBin& bin : region.bins) {
+    Eigen::Vector2d n1, n2;
+    double d1 = 0.0, d2 = 0.0;
+    if (!VerticalWedge(line, edge, sigmas, bin, &n1, &d1, &n2, &d2)) return true;
+    scratch.ClipFrom(bin.positions, n1, d1, n2, d2);
+    if (!scratch.Empty()) return true;
+  }
+  return false;
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,

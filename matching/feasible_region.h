@@ -60,6 +60,11 @@ struct FeasibleRegion {
                                   double radius, double bin_width);
 
   bool Empty() const { return bins.empty(); }
+  // True when some bin holds the pose (its heading, modulo 2 pi, and its position).
+  bool Contains(const Pose3Dof& pose) const;
+  // True when every bin's headings lie within `heading_margin` of pose.heading and every
+  // polygon vertex within `radius` of its position.
+  bool Within(const Pose3Dof& pose, double radius, double heading_margin) const;
   // Hull of the surviving headings.
   HeadingInterval Heading() const { return {bins.front().lo, bins.back().hi}; }
   // Representative poses: for each run of contiguous surviving bins, the middle bin's heading
@@ -81,11 +86,19 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     const FeasibleRegion& in, FeasibleRegion* out);
 
+// True when the non-vertical correspondence keeps some of `region` (AddNonVertical would not
+// empty it), without building the cut.
+bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                      const FeasibleRegion& region);
+
 // Cuts `region` with a vertical correspondence: each bin's polygon is clipped to the wedge of
 // rays from the foot for the bin's headings (widened by the bearing noise).
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  FeasibleRegion* region);
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  const FeasibleRegion& in, FeasibleRegion* out);
+// True when the vertical correspondence keeps some of `region`, without building the cut.
+bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const FeasibleRegion& region);
 
 }  // namespace linetrack

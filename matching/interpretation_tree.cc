@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 #include <optional>
+#include <set>
 
 namespace linetrack {
 namespace {
@@ -19,38 +20,71 @@ class TreeSearch {
  public:
   TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
              const PriorRegion& prior, const InterpretationTreeOptions& options,
-             const LeafVisitor& visit, InterpretationTreeStats* stats)
+             const std::vector<double>& line_caps, const LeafVisitor& visit,
+             InterpretationTreeStats* stats, const std::vector<VerifiedBasin>* basins)
       : edges_(edges),
         lines_(lines),
         prior_(prior),
         options_(options),
         visit_(visit),
         stats_(stats),
-        min_matches_(options.min_matches) {
+        basins_(basins) {
     gate_.sigmas = options.gate_sigmas;
     gate_.extent_slack_px = options.extent_slack_px;
     gate_.focal_px = prior.focal_px;
+    caps_ = line_caps.empty() ? std::vector<double>(lines.size(), 1.0) : line_caps;
   }
 
   void Run() {
     BuildLevels();
     const double min_width = DegToRad(options_.heading_bin_deg);
-    const FeasibleRegion root =
+    FeasibleRegion root =
         FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
                                   std::max(min_width, prior_.heading.Width() / options_.max_bins));
+    if (prior_.has_bounds) {
+      for (HeadingBin& bin : root.bins) {
+        bin.positions.ClipHalfPlane({1.0, 0.0}, -prior_.bounds_min.x());
+        bin.positions.ClipHalfPlane({-1.0, 0.0}, prior_.bounds_max.x());
+        bin.positions.ClipHalfPlane({0.0, 1.0}, -prior_.bounds_min.y());
+        bin.positions.ClipHalfPlane({0.0, -1.0}, prior_.bounds_max.y());
+      }
+      if (root.bins.front().positions.Empty()) return;
+    }
     used_.assign(lines_.size(), false);
-    reachable_lines_.assign(lines_.size(), false);
-    suffix_.assign(levels_.size() + 1, 0);
+    line_mark_.assign(lines_.size(), false);
+    level_assigned_.assign(levels_.size(), -1);
+    level_skipped_.assign(levels_.size(), false);
     regions_.resize(levels_.size() + 2);
+    alive_.assign(levels_.size() + 2, std::vector<char>(candidate_line_.size(), 1));
+    suffix_.assign(levels_.size() + 1, 0);
     for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
       suffix_[i] = suffix_[i + 1] + 1;
-    Search(0, root);
+    // Iterative deepening on the bound: from what all lines with a candidate could give, down
+    // by deepening_lines mean caps per pass, until the visitor's own bound is reached.
+    double top = 0.0;
+    int with_candidates = 0;
+    for (int line : candidate_line_) {
+      if (line_mark_[line]) continue;
+      line_mark_[line] = true;
+      top += caps_[line];
+      ++with_candidates;
+    }
+    std::fill(line_mark_.begin(), line_mark_.end(), false);
+    const double step =
+        options_.deepening_lines * (with_candidates > 0 ? top / with_candidates : 1.0);
+    for (double pass = top - step;; pass -= step) {
+      pass_bound_ = std::max(pass, 0.0);
+      ++stats_->passes;
+      Search(0, root);
+      if (stats_->budget_exhausted || pass_bound_ <= visitor_bound_ || pass_bound_ <= 0.0) break;
+    }
   }
 
  private:
   // Unary constraints: non-vertical edges against all lines, vertical edges against the lines
   // that can be images of vertical edges. Non-vertical levels first (they narrow the heading, so
-  // the vertical wedges then cut few bins), each group by candidate count, fewest first.
+  // the vertical wedges then cut few bins), each group by candidate count, fewest first; within a
+  // level the longest lines first (model lines tend to be long).
   void BuildLevels() {
     for (size_t e = 0; e < edges_.size(); ++e) {
       Level level;
@@ -74,12 +108,33 @@ class TreeSearch {
         }
       }
       stats_->unary_candidates += static_cast<int>(level.lines.size());
-      if (!level.lines.empty()) levels_.push_back(std::move(level));
+      if (level.lines.empty()) continue;
+      std::vector<size_t> order(level.lines.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        return lines_[level.lines[a]].length_px > lines_[level.lines[b]].length_px;
+      });
+      Level sorted;
+      sorted.edge = level.edge;
+      for (size_t i : order) {
+        sorted.lines.push_back(level.lines[i]);
+        sorted.headings.push_back(level.headings[i]);
+      }
+      levels_.push_back(std::move(sorted));
     }
     std::stable_sort(levels_.begin(), levels_.end(), [&](const Level& a, const Level& b) {
       if (edges_[a.edge].vertical != edges_[b.edge].vertical) return !edges_[a.edge].vertical;
       return a.lines.size() < b.lines.size();
     });
+    // Candidates flattened: level d holds [offsets_[d], offsets_[d + 1]).
+    offsets_.assign(1, 0);
+    for (const Level& level : levels_) {
+      for (int line : level.lines) {
+        candidate_level_.push_back(static_cast<int>(offsets_.size()) - 1);
+        candidate_line_.push_back(line);
+      }
+      offsets_.push_back(static_cast<int>(candidate_line_.size()));
+    }
   }
 
   // Writes `in` cut by (edge, line) into `out`; false when the pose set becomes empty or a binary
@@ -100,54 +155,113 @@ class TreeSearch {
     return AddVertical(l, e, options_.gate_sigmas, in, out);
   }
 
+  double Bound() const { return std::max(pass_bound_, visitor_bound_); }
+
   void Search(size_t depth, const FeasibleRegion& region) {
     if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
       stats_->budget_exhausted = true;
       return;
     }
     ++stats_->nodes;
-    if (static_cast<int>(assigned_.size()) + suffix_[depth] < min_matches_ ||
-        static_cast<int>(assigned_.size()) + Reachable(depth, region) < min_matches_) {
+    const int assigned = static_cast<int>(assigned_.size());
+    if (assigned + suffix_[depth] < options_.min_matches) return;
+    int reachable_levels = 0;
+    const double reachable = Reachable(depth, &reachable_levels);
+    if (assigned + reachable_levels < options_.min_matches ||
+        assigned_caps_ + reachable < Bound()) {
       return;
     }
+    if (InBasin(region)) return;
     if (depth == levels_.size()) {
-      if (IsMaximal(region)) {
-        ++stats_->leaves;
-        min_matches_ = std::max(min_matches_, visit_(Hypothesis{assigned_, region}));
-      }
+      VisitLeaf(depth, region);
       return;
     }
     const Level& level = levels_[depth];
-    const bool vertical = edges_[level.edge].vertical;
-    const HeadingInterval headings = region.Heading();
-    for (size_t c = 0; c < level.lines.size(); ++c) {
-      const int line = level.lines[c];
-      if (used_[line] || (vertical && VerticalsFull())) continue;
-      // Cheap test first: the candidate's unary heading interval must meet the region's.
-      if (level.headings[c].lo > headings.hi || level.headings[c].hi < headings.lo) continue;
+    const std::vector<char>& alive = alive_[depth];
+    for (int c = offsets_[depth]; c < offsets_[depth + 1]; ++c) {
+      const int line = candidate_line_[c];
+      if (!alive[c] || used_[line]) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
       FeasibleRegion& next = regions_[depth + 1];
       if (!Extend(level.edge, line, region, &next)) continue;
       next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
-      assigned_verticals_ += vertical ? 1 : 0;
+      assigned_caps_ += caps_[line];
+      level_assigned_[depth] = line;
+      ForwardCheck(depth, next, level.edge, line);
       Search(depth + 1, next);
-      assigned_verticals_ -= vertical ? 1 : 0;
+      level_assigned_[depth] = -1;
+      assigned_caps_ -= caps_[line];
       assigned_.pop_back();
       used_[line] = false;
     }
-    skipped_.push_back(static_cast<int>(depth));
+    level_skipped_[depth] = true;
+    alive_[depth + 1] = alive;
     Search(depth + 1, region);
-    skipped_.pop_back();
+    level_skipped_[depth] = false;
   }
 
-  // The tree assigns at most options_.max_vertical_matches vertical correspondences: they are
-  // weakly constrained one by one (many similar vertical lines and edges), so once a few fix the
-  // pose with the non-vertical ones, the verification's guided matching finds the others.
-  bool VerticalsFull() const {
-    return options_.max_vertical_matches > 0 &&
-           assigned_verticals_ >= options_.max_vertical_matches;
+  // Forward checking: the candidates alive at `depth` that stay consistent with `region` after
+  // (edge, line) was assigned there, written to alive_[depth + 1]. Candidates of used lines die.
+  void ForwardCheck(size_t depth, const FeasibleRegion& region, int edge, int line) {
+    const std::vector<char>& in = alive_[depth];
+    std::vector<char>& out = alive_[depth + 1];
+    const bool vertical = edges_[edge].vertical;
+    for (size_t c = 0; c < candidate_line_.size(); ++c) {
+      out[c] = 0;
+      const int other_line = candidate_line_[c];
+      if (!in[c] || used_[other_line]) continue;
+      const int other_edge = levels_[candidate_level_[c]].edge;
+      const MatchEdge& e = edges_[other_edge];
+      const ObservedLine& l = lines_[other_line];
+      if (e.vertical) {
+        if (vertical && other_edge != edge &&
+            !BinaryVertical(lines_[line], l, AngleRange(edge, other_edge), options_.gate_sigmas)) {
+          continue;
+        }
+        out[c] = MeetsVertical(l, e, options_.gate_sigmas, region) ? 1 : 0;
+      } else {
+        out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
+      }
+    }
+  }
+
+  // True when the region lies in the basin of a verified pose: its leaves are the same answer.
+  bool InBasin(const FeasibleRegion& region) const {
+    if (basins_ == nullptr) return false;
+    return std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
+      return region.Within(b.pose, b.radius_m, b.heading_rad);
+    });
+  }
+
+  void VisitLeaf(size_t depth, const FeasibleRegion& region) {
+    if (!IsMaximal(depth, region)) return;
+    // A leaf consistent with a verified pose would be verified into it again.
+    if (basins_ != nullptr &&
+        std::any_of(basins_->begin(), basins_->end(),
+                    [&](const VerifiedBasin& b) { return region.Contains(b.pose); })) {
+      return;
+    }
+    Hypothesis leaf{assigned_, region, assigned_caps_};
+    // Fragments: unused lines an assigned edge could also take within the region.
+    const std::vector<char>& alive = alive_[depth];
+    for (size_t c = 0; c < candidate_line_.size(); ++c) {
+      const int line = candidate_line_[c];
+      if (!alive[c] || used_[line] || line_mark_[line] ||
+          level_assigned_[candidate_level_[c]] < 0) {
+        continue;
+      }
+      line_mark_[line] = true;
+      leaf.bound += caps_[line];
+    }
+    std::fill(line_mark_.begin(), line_mark_.end(), false);
+    if (leaf.bound < Bound()) return;
+    std::vector<std::pair<int, int>> key = leaf.pairs;
+    std::sort(key.begin(), key.end());
+    if (!visited_.insert(std::move(key)).second) return;
+    ++stats_->leaves;
+    visitor_bound_ = std::max(visitor_bound_, visit_(leaf));
   }
 
   // Inscribed-angle range of two vertical edges over the prior disk, computed once per pair.
@@ -161,36 +275,32 @@ class TreeSearch {
     return *angle_ranges_[key];
   }
 
-  // Upper bound on the levels from `depth` on that can still be matched: those with an unused
-  // candidate whose unary heading interval meets the region's headings, and no more than the
-  // distinct lines among those candidates (each line matches one edge).
-  int Reachable(size_t depth, const FeasibleRegion& region) const {
-    if (region.Empty()) return 0;
-    const HeadingInterval h = region.Heading();
-    int levels = 0, vertical_levels = 0;
-    std::fill(reachable_lines_.begin(), reachable_lines_.end(), false);
+  // Upper bound on what the levels from `depth` on can still add: the caps of the unused lines
+  // with a candidate alive at a remaining level or at an assigned one (a second fragment).
+  // *levels gets the remaining levels with an alive candidate, no more than the distinct lines
+  // among them (each line matches one edge).
+  double Reachable(size_t depth, int* levels) const {
+    const std::vector<char>& alive = alive_[depth];
+    double caps = 0.0;
     int lines = 0;
-    for (size_t d = depth; d < levels_.size(); ++d) {
-      const Level& level = levels_[d];
-      const bool vertical = edges_[level.edge].vertical;
-      if (vertical && VerticalsFull()) continue;
-      bool any = false;
-      for (size_t c = 0; c < level.lines.size(); ++c) {
-        const int line = level.lines[c];
-        if (used_[line] || level.headings[c].lo > h.hi || level.headings[c].hi < h.lo) continue;
-        any = true;
-        if (!reachable_lines_[line]) {
-          reachable_lines_[line] = true;
-          ++lines;
-        }
+    *levels = 0;
+    for (size_t d = 0; d < levels_.size(); ++d) {
+      if (d < depth && level_assigned_[d] < 0) continue;
+      bool hit = false;
+      for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
+        const int line = candidate_line_[c];
+        if (!alive[c] || used_[line]) continue;
+        hit = true;
+        if (line_mark_[line]) continue;
+        line_mark_[line] = true;
+        caps += caps_[line];
+        ++lines;
       }
-      if (any) (vertical ? vertical_levels : levels) += 1;
+      if (hit && d >= depth) ++*levels;
     }
-    if (options_.max_vertical_matches > 0) {
-      vertical_levels =
-          std::min(vertical_levels, options_.max_vertical_matches - assigned_verticals_);
-    }
-    return std::min(levels + vertical_levels, lines);
+    std::fill(line_mark_.begin(), line_mark_.end(), false);
+    *levels = std::min(*levels, lines);
+    return caps;
   }
 
   // True when the extension keeps most of the region (at least half of its heading bins and a
@@ -216,13 +326,14 @@ class TreeSearch {
   // A leaf is kept only when no skipped edge could have been matched as well in every pose
   // cluster: every subset of a consistent assignment is consistent, and verifying those again
   // would be wasted work.
-  bool IsMaximal(const FeasibleRegion& region) const {
-    for (int depth : skipped_) {
-      const Level& level = levels_[depth];
-      if (edges_[level.edge].vertical && VerticalsFull()) continue;
-      for (int line : level.lines) {
-        if (used_[line]) continue;
-        if (Extend(level.edge, line, region, &maximal_scratch_) &&
+  bool IsMaximal(size_t depth, const FeasibleRegion& region) const {
+    const std::vector<char>& alive = alive_[depth];
+    for (size_t d = 0; d < levels_.size(); ++d) {
+      if (!level_skipped_[d]) continue;
+      for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
+        const int line = candidate_line_[c];
+        if (!alive[c] || used_[line]) continue;
+        if (Extend(levels_[d].edge, line, region, &maximal_scratch_) &&
             KeepsEveryCluster(region, maximal_scratch_)) {
           return false;
         }
@@ -237,17 +348,26 @@ class TreeSearch {
   const InterpretationTreeOptions& options_;
   const LeafVisitor& visit_;
   InterpretationTreeStats* stats_;
-  int min_matches_;
+  const std::vector<VerifiedBasin>* basins_;
   Gate gate_;
+  std::vector<double> caps_;
   std::vector<Level> levels_;
+  // All candidates flattened by level: their level and line.
+  std::vector<int> offsets_, candidate_level_, candidate_line_;
+  // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
+  std::vector<std::vector<char>> alive_;
   std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
-  mutable std::vector<bool> reachable_lines_;  // scratch of Reachable()
-  std::vector<FeasibleRegion> regions_;        // per depth
+  std::vector<int> level_assigned_;      // line assigned at each level on the current branch, or -1
+  std::vector<bool> level_skipped_;      // levels skipped on the current branch
+  mutable std::vector<bool> line_mark_;  // scratch: lines counted once
+  std::vector<FeasibleRegion> regions_;  // per depth
   mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
-  int assigned_verticals_ = 0;
-  std::vector<int> skipped_;
+  double assigned_caps_ = 0.0;
+  double pass_bound_ = 0.0;
+  double visitor_bound_ = 0.0;
+  std::set<std::vector<std::pair<int, int>>> visited_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };
 
@@ -255,8 +375,11 @@ class TreeSearch {
 
 bool InterpretationTreeOptions::Check(std::string* why) const {
   if (!(gate_sigmas > 0.0) || min_matches < 2 || max_nodes < 1 || max_hypotheses < 1 ||
-      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1) {
-    *why = "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1";
+      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1 ||
+      !(deepening_lines > 0.0)) {
+    *why =
+        "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1, "
+        "deepening_lines > 0";
     return false;
   }
   return true;
@@ -264,10 +387,12 @@ bool InterpretationTreeOptions::Check(std::string* why) const {
 
 void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
                               const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats) {
+                              const InterpretationTreeOptions& options,
+                              const std::vector<double>& line_caps, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats,
+                              const std::vector<VerifiedBasin>* basins) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, visit, stats).Run();
+  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Run();
 }
 
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
@@ -277,10 +402,10 @@ std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            InterpretationTreeStats* stats) {
   std::vector<Hypothesis> leaves;
   SearchInterpretationTree(
-      edges, lines, prior, options,
+      edges, lines, prior, options, {},
       [&](const Hypothesis& h) {
         leaves.push_back(h);
-        return 0;
+        return 0.0;
       },
       stats);
   return leaves;

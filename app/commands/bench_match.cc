@@ -126,7 +126,7 @@ Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, dou
 
 // The first stage at which the truth is lost (see matching/diagnosis.h).
 std::string Classify(const TruthDiagnosis& d, const LocalizationResult& result) {
-  if (d.position_sigma_m > 0.15 || d.heading_sigma_deg > 1.5) return "uninformative truth";
+  if (!d.plausible && d.implausible_because == "unobservable") return "uninformative truth";
   if (d.candidate_edges < d.true_edges) return "true edge not a candidate";
   if (d.unary_edges < d.candidate_edges) return "true pair cut by a unary constraint";
   if (!d.region_consistent) return "truth's region emptied";

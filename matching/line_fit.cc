@@ -1,0 +1,69 @@
+#include "matching/line_fit.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+namespace linetrack {
+
+Eigen::Matrix2d EndpointNoiseCovariance(double t_a, double t_b, double sigma_d,
+                                        double sigma_theta) {
+  const double d2 = sigma_d * sigma_d, a2 = sigma_theta * sigma_theta;
+  Eigen::Matrix2d c;
+  c << d2 + a2 * t_a * t_a, d2 + a2 * t_a * t_b, d2 + a2 * t_a * t_b, d2 + a2 * t_b * t_b;
+  return c;
+}
+
+double EndpointAlongDensity(double t, double length, double sigma, double end_probability) {
+  const double d = t < 0.0 || t > length ? std::max(-t, t - length) : std::min(t, length - t);
+  constexpr double kHalfNormal = 0.7978845608028654;  // sqrt(2 / pi)
+  return end_probability * kHalfNormal / sigma * std::exp(-0.5 * d * d / (sigma * sigma)) +
+         (1.0 - end_probability) / length;
+}
+
+double MaxLogLikelihoodRatio(double length, const LineFitModel& model) {
+  const double d = model.image_diagonal_px;
+  // The projected piece may be shorter than the segment by the overhang tolerance at each end.
+  const double piece = std::max(length - 2.0 * model.extent_sigmas * model.offset_px, 1.0);
+  const double end_sigma = std::hypot(model.end_shortening * piece, model.offset_px);
+  return std::log(d / (2.0 * model.offset_px * model.angle_rad)) +
+         2.0 * std::log(d * EndpointAlongDensity(0.0, piece, end_sigma, model.end_probability));
+}
+
+LineFit FitLine(const Segment2& projected, const Segment2& observed,
+                const Eigen::Matrix2d& pose_term, const LineFitModel& model) {
+  LineFit fit;
+  const Eigen::Vector2d axis = projected.b - projected.a;
+  const double lambda = axis.norm();
+  const double length = observed.Length();
+  if (lambda < 1e-9 || length < 1e-9) return fit;
+  const Eigen::Vector2d u = axis / lambda, n(-u.y(), u.x());
+  fit.residuals = {n.dot(observed.a - projected.a), n.dot(observed.b - projected.a)};
+  const double s_a = u.dot(observed.a - projected.a), s_b = u.dot(observed.b - projected.a);
+  fit.lo = std::min(s_a, s_b);
+  fit.hi = std::max(s_a, s_b);
+  fit.overhang_px = std::max({0.0, -fit.lo, fit.hi - lambda});
+  // Levers from the middle of the projected piece: the rotation centre of the noise model.
+  const double centre = 0.5 * lambda;
+  fit.covariance =
+      EndpointNoiseCovariance(s_a - centre, s_b - centre, model.offset_px, model.angle_rad) +
+      pose_term;
+  const double det = fit.covariance.determinant();
+  if (!(det > 0.0)) return fit;
+  fit.chi2 = fit.residuals.dot(fit.covariance.inverse() * fit.residuals);
+  // Endpoint position noise along the edge, taken as the perpendicular one's.
+  const double position_sigma = std::sqrt(0.5 * fit.covariance.trace());
+  const double end_sigma = std::hypot(model.end_shortening * lambda, position_sigma);
+  const double along =
+      std::log(model.image_diagonal_px *
+               EndpointAlongDensity(s_a, lambda, end_sigma, model.end_probability)) +
+      std::log(model.image_diagonal_px *
+               EndpointAlongDensity(s_b, lambda, end_sigma, model.end_probability));
+  fit.log_likelihood_ratio =
+      std::log(model.image_diagonal_px * length / (2.0 * std::sqrt(det))) - 0.5 * fit.chi2 + along;
+  fit.gated =
+      fit.chi2 <= model.gate_chi2 && fit.overhang_px <= model.extent_sigmas * position_sigma;
+  return fit;
+}
+
+}  // namespace linetrack
