@@ -108,8 +108,15 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p,
 
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double heading, const Eigen::Vector2d& at, double sigmas) {
-  const Eigen::Vector3d w = LevelFromWorld(heading) * (p - Eigen::Vector3d(at.x(), at.y(), height));
-  const Eigen::Vector3d l = PositionLine(line.normal, p, height, heading);
+  return PositionBandHalfWidth(line, p, height, std::cos(heading), std::sin(heading), at, sigmas);
+}
+
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double ch, double sh, const Eigen::Vector2d& at, double sigmas) {
+  // Rl(h) (p - C), Rl(h) with rows (sin h, -cos h, 0), (0, 0, -1), (cos h, sin h, 0).
+  const Eigen::Vector3d d = p - Eigen::Vector3d(at.x(), at.y(), height);
+  const Eigen::Vector3d w(sh * d.x() - ch * d.y(), -d.z(), ch * d.x() + sh * d.y());
+  const Eigen::Vector3d l = PositionLine(line.normal, p, height, ch, sh);
   const double ab = std::hypot(l.x(), l.y());
   if (ab < 1e-12) return std::numeric_limits<double>::infinity();
   return sigmas * std::sqrt(FormVariance(line, w)) / ab;

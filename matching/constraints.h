@@ -75,6 +75,9 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& normal, const Eigen::Vector3
 // sigmas * std(g2) / |(A, B)|.
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double heading, const Eigen::Vector2d& at, double sigmas);
+// The same with cos h, sin h given (hot loops).
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas);
 
 // The point of the edge (clamped to it) seen along the segment's middle ray from camera
 // position `at` at heading h: the closest point of the edge's line to that viewing ray. The

@@ -211,31 +211,44 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
     slack =
         std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
   }
-  return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
-          PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas) + slack};
+  return {
+      Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
+      PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas) +
+          slack};
 }
 
-// The wedge of camera positions a vertical correspondence allows in `bin`: n1 . q + d1 >= 0 and
-// n2 . q + d2 >= 0; false when the bin is too wide for a wedge (everything allowed).
-bool VerticalWedge(const ObservedLine& line, const MatchEdge& edge, double sigmas,
-                   const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-                   double* d2) {
-  const double margin = sigmas * line.bearing_sigma;
-  if (bin.hi - bin.lo + 2.0 * margin >= kPi) return false;
-  // Camera directions from the foot: (h - w) + pi for h in the bin, widened by the margin:
-  // from bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
-  const Eigen::Vector2d a = Trig(-line.bearing - margin + kPi),
-                        b = Trig(-line.bearing + margin + kPi);
-  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-  };
-  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a), u2 = rotate(bin.trig_hi, b);
-  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
-  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
-  *d1 = -n1->dot(edge.foot);
-  *d2 = -n2->dot(edge.foot);
-  return true;
-}
+// The wedges of camera positions a vertical correspondence allows: for a bin, the camera
+// directions from the foot are (h - w) + pi for h in the bin, widened by the margin -- from
+// bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
+class VerticalWedges {
+ public:
+  VerticalWedges(const ObservedLine& line, const MatchEdge& edge, double sigmas)
+      : foot_(edge.foot),
+        margin_(sigmas * line.bearing_sigma),
+        a_(Trig(-line.bearing - margin_ + kPi)),
+        b_(Trig(-line.bearing + margin_ + kPi)) {}
+
+  // The wedge in `bin`: n1 . q + d1 >= 0 and n2 . q + d2 >= 0; false when the bin is too wide
+  // for a wedge (everything allowed).
+  bool In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
+          double* d2) const {
+    if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
+    auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+      return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+    };
+    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
+    *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+    *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+    *d1 = -n1->dot(foot_);
+    *d2 = -n2->dot(foot_);
+    return true;
+  }
+
+ private:
+  Eigen::Vector2d foot_;
+  double margin_;
+  Eigen::Vector2d a_, b_;
+};
 
 // Quick reject of a vertical correspondence: the directions from the foot to the region's
 // bounding box must meet the camera directions the headings allow.
@@ -305,11 +318,12 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
   if (!VerticalMayMeet(line, edge, sigmas, in)) return false;
+  const VerticalWedges wedges(line, edge, sigmas);
   for (const HeadingBin& bin : in.bins) {
     HeadingBin& cut = Append(bin, out);
     Eigen::Vector2d n1, n2;
     double d1 = 0.0, d2 = 0.0;
-    if (!VerticalWedge(line, edge, sigmas, bin, &n1, &d1, &n2, &d2)) {
+    if (!wedges.In(bin, &n1, &d1, &n2, &d2)) {
       cut.positions = bin.positions;
       continue;
     }
@@ -322,11 +336,23 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
 bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                    const FeasibleRegion& region) {
   if (!VerticalMayMeet(line, edge, sigmas, region)) return false;
+  const VerticalWedges wedges(line, edge, sigmas);
   ConvexPolygon scratch;
   for (const HeadingBin& bin : region.bins) {
     Eigen::Vector2d n1, n2;
     double d1 = 0.0, d2 = 0.0;
-    if (!VerticalWedge(line, edge, sigmas, bin, &n1, &d1, &n2, &d2)) return true;
+    if (!wedges.In(bin, &n1, &d1, &n2, &d2)) return true;
+    // Quick answers before clipping: every vertex outside one half-plane (no), or inside both
+    // (yes).
+    bool all_in = true, any_in1 = false, any_in2 = false;
+    for (const Eigen::Vector2d& q : bin.positions) {
+      const bool in1 = n1.dot(q) + d1 >= 0.0, in2 = n2.dot(q) + d2 >= 0.0;
+      any_in1 = any_in1 || in1;
+      any_in2 = any_in2 || in2;
+      all_in = all_in && in1 && in2;
+    }
+    if (all_in && !bin.positions.Empty()) return true;
+    if (!any_in1 || !any_in2) continue;
     scratch.ClipFrom(bin.positions, n1, d1, n2, d2);
     if (!scratch.Empty()) return true;
   }

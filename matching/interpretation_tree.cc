@@ -56,9 +56,7 @@ class TreeSearch {
     level_skipped_.assign(levels_.size(), false);
     regions_.resize(levels_.size() + 2);
     alive_.assign(levels_.size() + 2, std::vector<char>(candidate_line_.size(), 1));
-    suffix_.assign(levels_.size() + 1, 0);
-    for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
-      suffix_[i] = suffix_[i + 1] + 1;
+    processed_.assign(levels_.size(), false);
     // Iterative deepening on the bound: from what all lines with a candidate could give, down
     // by deepening_lines mean caps per pass, until the visitor's own bound is reached.
     double top = 0.0;
@@ -157,28 +155,29 @@ class TreeSearch {
 
   double Bound() const { return std::max(pass_bound_, visitor_bound_); }
 
+  // One node: `depth` decisions taken (each an assignment or a skip of one level). The next
+  // level is the unprocessed one with the fewest alive candidates (most constrained first);
+  // levels with none are left out (they cannot be matched any more).
   void Search(size_t depth, const FeasibleRegion& region) {
     if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
       stats_->budget_exhausted = true;
       return;
     }
     ++stats_->nodes;
-    const int assigned = static_cast<int>(assigned_.size());
-    if (assigned + suffix_[depth] < options_.min_matches) return;
-    int reachable_levels = 0;
-    const double reachable = Reachable(depth, &reachable_levels);
-    if (assigned + reachable_levels < options_.min_matches ||
-        assigned_caps_ + reachable < Bound()) {
-      return;
-    }
-    if (InBasin(region)) return;
-    if (depth == levels_.size()) {
-      VisitLeaf(depth, region);
-      return;
-    }
-    const Level& level = levels_[depth];
     const std::vector<char>& alive = alive_[depth];
-    for (int c = offsets_[depth]; c < offsets_[depth + 1]; ++c) {
+    int next_level = -1, fewest = 0, open_levels = 0;
+    const double reachable = Reachable(alive, &next_level, &fewest, &open_levels);
+    if (static_cast<int>(assigned_.size()) + open_levels < options_.min_matches ||
+        assigned_caps_ + reachable < Bound() || InBasin(region)) {
+      return;
+    }
+    if (next_level < 0) {
+      VisitLeaf(alive, region);
+      return;
+    }
+    const Level& level = levels_[next_level];
+    processed_[next_level] = true;
+    for (int c = offsets_[next_level]; c < offsets_[next_level + 1]; ++c) {
       const int line = candidate_line_[c];
       if (!alive[c] || used_[line]) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
@@ -188,18 +187,19 @@ class TreeSearch {
       used_[line] = true;
       assigned_.emplace_back(level.edge, line);
       assigned_caps_ += caps_[line];
-      level_assigned_[depth] = line;
+      level_assigned_[next_level] = line;
       ForwardCheck(depth, next, level.edge, line);
       Search(depth + 1, next);
-      level_assigned_[depth] = -1;
+      level_assigned_[next_level] = -1;
       assigned_caps_ -= caps_[line];
       assigned_.pop_back();
       used_[line] = false;
     }
-    level_skipped_[depth] = true;
+    level_skipped_[next_level] = true;
     alive_[depth + 1] = alive;
     Search(depth + 1, region);
-    level_skipped_[depth] = false;
+    level_skipped_[next_level] = false;
+    processed_[next_level] = false;
   }
 
   // Forward checking: the candidates alive at `depth` that stay consistent with `region` after
@@ -235,8 +235,8 @@ class TreeSearch {
     });
   }
 
-  void VisitLeaf(size_t depth, const FeasibleRegion& region) {
-    if (!IsMaximal(depth, region)) return;
+  void VisitLeaf(const std::vector<char>& alive, const FeasibleRegion& region) {
+    if (!IsMaximal(alive, region)) return;
     // A leaf consistent with a verified pose would be verified into it again.
     if (basins_ != nullptr &&
         std::any_of(basins_->begin(), basins_->end(),
@@ -245,7 +245,6 @@ class TreeSearch {
     }
     Hypothesis leaf{assigned_, region, assigned_caps_};
     // Fragments: unused lines an assigned edge could also take within the region.
-    const std::vector<char>& alive = alive_[depth];
     for (size_t c = 0; c < candidate_line_.size(); ++c) {
       const int line = candidate_line_[c];
       if (!alive[c] || used_[line] || line_mark_[line] ||
@@ -275,31 +274,39 @@ class TreeSearch {
     return *angle_ranges_[key];
   }
 
-  // Upper bound on what the levels from `depth` on can still add: the caps of the unused lines
-  // with a candidate alive at a remaining level or at an assigned one (a second fragment).
-  // *levels gets the remaining levels with an alive candidate, no more than the distinct lines
-  // among them (each line matches one edge).
-  double Reachable(size_t depth, int* levels) const {
-    const std::vector<char>& alive = alive_[depth];
+  // Upper bound on what the unprocessed levels can still add: the caps of the unused lines with
+  // a candidate alive at an unprocessed level or at an assigned one (a second fragment).
+  // *open_levels gets the unprocessed levels with an alive candidate, no more than the distinct
+  // lines among them (each line matches one edge); *next_level the one of them with the fewest
+  // (*fewest) alive candidates, -1 when there is none.
+  double Reachable(const std::vector<char>& alive, int* next_level, int* fewest,
+                   int* open_levels) const {
     double caps = 0.0;
     int lines = 0;
-    *levels = 0;
+    *open_levels = 0;
+    *next_level = -1;
     for (size_t d = 0; d < levels_.size(); ++d) {
-      if (d < depth && level_assigned_[d] < 0) continue;
-      bool hit = false;
+      const bool open = !processed_[d];
+      if (!open && level_assigned_[d] < 0) continue;
+      int count = 0;
       for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
         const int line = candidate_line_[c];
         if (!alive[c] || used_[line]) continue;
-        hit = true;
+        ++count;
         if (line_mark_[line]) continue;
         line_mark_[line] = true;
         caps += caps_[line];
         ++lines;
       }
-      if (hit && d >= depth) ++*levels;
+      if (!open || count == 0) continue;
+      ++*open_levels;
+      if (*next_level < 0 || count < *fewest) {
+        *next_level = static_cast<int>(d);
+        *fewest = count;
+      }
     }
     std::fill(line_mark_.begin(), line_mark_.end(), false);
-    *levels = std::min(*levels, lines);
+    *open_levels = std::min(*open_levels, lines);
     return caps;
   }
 
@@ -326,8 +333,7 @@ class TreeSearch {
   // A leaf is kept only when no skipped edge could have been matched as well in every pose
   // cluster: every subset of a consistent assignment is consistent, and verifying those again
   // would be wasted work.
-  bool IsMaximal(size_t depth, const FeasibleRegion& region) const {
-    const std::vector<char>& alive = alive_[depth];
+  bool IsMaximal(const std::vector<char>& alive, const FeasibleRegion& region) const {
     for (size_t d = 0; d < levels_.size(); ++d) {
       if (!level_skipped_[d]) continue;
       for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
@@ -356,10 +362,10 @@ class TreeSearch {
   std::vector<int> offsets_, candidate_level_, candidate_line_;
   // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
   std::vector<std::vector<char>> alive_;
-  std::vector<int> suffix_;  // levels remaining from each depth
   std::vector<bool> used_;
   std::vector<int> level_assigned_;      // line assigned at each level on the current branch, or -1
   std::vector<bool> level_skipped_;      // levels skipped on the current branch
+  std::vector<bool> processed_;          // levels assigned or skipped on the current branch
   mutable std::vector<bool> line_mark_;  // scratch: lines counted once
   std::vector<FeasibleRegion> regions_;  // per depth
   mutable FeasibleRegion maximal_scratch_;

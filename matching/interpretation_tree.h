@@ -28,7 +28,7 @@ struct InterpretationTreeOptions {
   int max_bins = 96;                  // bins are split finer as the headings narrow, up to this
   int min_matches = 4;                // k: leaves with fewer correspondences are discarded
   // Iterative deepening: each pass lowers the bound by this many lines' worth of caps.
-  double deepening_lines = 1000.0;
+  double deepening_lines = 2.0;
   int max_nodes = 20000;     // search budget (deterministic), over all passes
   int max_hypotheses = 200;  // leaves handed to the visitor at most
 

@@ -110,7 +110,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     const LineFitModel fit_model = FitModel(context, vo);
     std::vector<double> caps;
     for (const ObservedLine& line : lines)
-      caps.push_back(MaxLogLikelihoodRatio(line.length_px, fit_model));
+      caps.push_back(MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density);
     double best = -std::numeric_limits<double>::infinity();
     std::vector<std::vector<std::pair<int, int>>> verified_pairs;
     std::vector<VerifiedBasin> basins;

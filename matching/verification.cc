@@ -143,8 +143,8 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
       Eigen::Matrix<double, 2, 4> j;
       j.row(0) = qa.transpose() * image.d_line;
       j.row(1) = qb.transpose() * image.d_line;
-      const LineFit fit =
-          FitLine(image.image, observed, j * pose_covariance * j.transpose(), model);
+      LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model);
+      fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
       if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
       if (context.occlusion != nullptr &&
           context.occlusion->Blocked(

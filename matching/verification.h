@@ -44,7 +44,7 @@ struct VerificationOptions {
   // edge, clutter, or a rival line over the same stretch of the edge).
   double ambiguity_nats = 4.6;
   double min_evidence_nats = 40.0;
-  double report_nats = 4.6;
+  double report_nats = 7.6;
   int min_matches = 4;
   int min_confident_edges = 3;
   double same_pose_m = 0.5;
