@@ -8,14 +8,11 @@
 namespace linetrack {
 namespace {
 
-// One level of the tree: a model edge and the lines that pass its unary constraint, with the
-// heading interval each allows.
-struct Level {
-  int edge = -1;
-  std::vector<int> lines;
-  std::vector<HeadingInterval> headings;
-};
-
+// The tree is searched line by line (the data-driven order of Grimson's interpretation tree):
+// each image line is assigned one of its candidate model edges or none (clutter). An edge may
+// take several lines when they do not overlap along it (fragments). Correspondence sets are the
+// same as with the edge-major order of Ait Aider et al.; this order makes the bound tight: every
+// line left unexplained removes its cap from the bound at once.
 class TreeSearch {
  public:
   TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
@@ -36,7 +33,7 @@ class TreeSearch {
   }
 
   void Run() {
-    BuildLevels();
+    BuildCandidates();
     const double min_width = DegToRad(options_.heading_bin_deg);
     FeasibleRegion root =
         FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
@@ -50,26 +47,22 @@ class TreeSearch {
       }
       if (root.bins.front().positions.Empty()) return;
     }
-    used_.assign(lines_.size(), false);
-    line_mark_.assign(lines_.size(), false);
-    level_assigned_.assign(levels_.size(), -1);
-    level_skipped_.assign(levels_.size(), false);
-    regions_.resize(levels_.size() + 2);
-    alive_.assign(levels_.size() + 2, std::vector<char>(candidate_line_.size(), 1));
-    processed_.assign(levels_.size(), false);
+    const size_t n = lines_.size();
+    decided_.assign(n, kUndecided);
+    edge_lines_.assign(edges_.size(), 0);
+    regions_.resize(n + 2);
+    alive_.assign(n + 2, std::vector<char>(candidate_edge_.size(), 1));
     // Iterative deepening on the bound: from what all lines with a candidate could give, down
     // by deepening_lines mean caps per pass, until the visitor's own bound is reached.
     double top = 0.0;
     int with_candidates = 0;
-    for (int line : candidate_line_) {
-      if (line_mark_[line]) continue;
-      line_mark_[line] = true;
-      top += caps_[line];
+    for (size_t j = 0; j < n; ++j) {
+      if (line_offsets_[j] == line_offsets_[j + 1]) continue;
+      top += caps_[j];
       ++with_candidates;
     }
-    std::fill(line_mark_.begin(), line_mark_.end(), false);
-    const double step =
-        options_.deepening_lines * (with_candidates > 0 ? top / with_candidates : 1.0);
+    if (with_candidates == 0) return;
+    const double step = options_.deepening_lines * top / with_candidates;
     for (double pass = top - step;; pass -= step) {
       pass_bound_ = std::max(pass, 0.0);
       ++stats_->passes;
@@ -79,60 +72,56 @@ class TreeSearch {
   }
 
  private:
-  // Unary constraints: non-vertical edges against all lines, vertical edges against the lines
-  // that can be images of vertical edges. Non-vertical levels first (they narrow the heading, so
-  // the vertical wedges then cut few bins), each group by candidate count, fewest first; within a
-  // level the longest lines first (model lines tend to be long).
-  void BuildLevels() {
-    for (size_t e = 0; e < edges_.size(); ++e) {
-      Level level;
-      level.edge = static_cast<int>(e);
-      for (size_t j = 0; j < lines_.size(); ++j) {
+  static constexpr int kUndecided = -1;
+  static constexpr int kClutter = -2;
+
+  // Unary constraints: each line against the non-vertical edges and, when it can be the image of
+  // a vertical edge, against the vertical ones. Lines are searched by decreasing cap (long lines
+  // first: model lines tend to be long, and they constrain the pose most).
+  void BuildCandidates() {
+    order_.resize(lines_.size());
+    std::iota(order_.begin(), order_.end(), 0);
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](int a, int b) { return caps_[a] > caps_[b]; });
+    line_offsets_.assign(1, 0);
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      for (size_t e = 0; e < edges_.size(); ++e) {
+        bool pass = false;
         if (edges_[e].vertical) {
-          if (!lines_[j].maybe_vertical) continue;
-          const std::optional<HeadingInterval> h =
-              UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                            prior_.radius, gate_);
-          if (!h) continue;
-          level.lines.push_back(static_cast<int>(j));
-          level.headings.push_back(*h);
+          pass = lines_[j].maybe_vertical &&
+                 UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
+                               prior_.radius, gate_)
+                     .has_value();
         } else {
-          const std::vector<HeadingInterval> h =
-              UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                               prior_.radius, gate_);
-          if (h.empty()) continue;
-          level.lines.push_back(static_cast<int>(j));
-          level.headings.push_back({h.front().lo, h.back().hi});
+          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
+                                   prior_.centre, prior_.radius, gate_)
+                      .empty();
         }
+        if (!pass) continue;
+        candidate_edge_.push_back(static_cast<int>(e));
+        candidate_line_.push_back(static_cast<int>(j));
       }
-      stats_->unary_candidates += static_cast<int>(level.lines.size());
-      if (level.lines.empty()) continue;
-      std::vector<size_t> order(level.lines.size());
-      std::iota(order.begin(), order.end(), 0);
-      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-        return lines_[level.lines[a]].length_px > lines_[level.lines[b]].length_px;
-      });
-      Level sorted;
-      sorted.edge = level.edge;
-      for (size_t i : order) {
-        sorted.lines.push_back(level.lines[i]);
-        sorted.headings.push_back(level.headings[i]);
-      }
-      levels_.push_back(std::move(sorted));
+      line_offsets_.push_back(static_cast<int>(candidate_edge_.size()));
     }
-    std::stable_sort(levels_.begin(), levels_.end(), [&](const Level& a, const Level& b) {
-      if (edges_[a.edge].vertical != edges_[b.edge].vertical) return !edges_[a.edge].vertical;
-      return a.lines.size() < b.lines.size();
-    });
-    // Candidates flattened: level d holds [offsets_[d], offsets_[d + 1]).
-    offsets_.assign(1, 0);
-    for (const Level& level : levels_) {
-      for (int line : level.lines) {
-        candidate_level_.push_back(static_cast<int>(offsets_.size()) - 1);
-        candidate_line_.push_back(line);
-      }
-      offsets_.push_back(static_cast<int>(candidate_line_.size()));
+    stats_->unary_candidates = static_cast<int>(candidate_edge_.size());
+  }
+
+  // True when `line` overlaps (beyond the noise) a line already assigned to `edge`: fragments of
+  // one edge do not overlap.
+  bool OverlapsAssigned(int edge, int line) const {
+    if (edge_lines_[edge] == 0) return false;
+    const Segment2& s = lines_[line].pixels;
+    const Eigen::Vector2d axis = (s.b - s.a) / s.Length();
+    const double tolerance = gate_.extent_slack_px;
+    for (const auto& [e, l] : assigned_) {
+      if (e != edge) continue;
+      const Segment2& t = lines_[l].pixels;
+      const double t0 = (t.a - s.a).dot(axis), t1 = (t.b - s.a).dot(axis);
+      const double overlap =
+          std::min(std::max(t0, t1), s.Length()) - std::max(std::min(t0, t1), 0.0);
+      if (overlap > tolerance) return true;
     }
+    return false;
   }
 
   // Writes `in` cut by (edge, line) into `out`; false when the pose set becomes empty or a binary
@@ -155,9 +144,9 @@ class TreeSearch {
 
   double Bound() const { return std::max(pass_bound_, visitor_bound_); }
 
-  // One node: `depth` decisions taken (each an assignment or a skip of one level). The next
-  // level is the unprocessed one with the fewest alive candidates (most constrained first);
-  // levels with none are left out (they cannot be matched any more).
+  // One node: `depth` lines decided. The next line is the first undecided one (in cap order)
+  // with a candidate still alive; lines without one are clutter for free (their cap is no longer
+  // in the bound).
   void Search(size_t depth, const FeasibleRegion& region) {
     if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
       stats_->budget_exhausted = true;
@@ -165,66 +154,103 @@ class TreeSearch {
     }
     ++stats_->nodes;
     const std::vector<char>& alive = alive_[depth];
-    int next_level = -1, fewest = 0, open_levels = 0;
-    const double reachable = Reachable(alive, &next_level, &fewest, &open_levels);
-    if (static_cast<int>(assigned_.size()) + open_levels < options_.min_matches ||
-        assigned_caps_ + reachable < Bound() || InBasin(region)) {
+    double reachable = 0.0;
+    int open_lines = 0, next = -1;
+    for (int j : order_) {
+      if (decided_[j] != kUndecided) continue;
+      bool any = false;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1] && !any; ++c)
+        any = alive[c];
+      if (!any) continue;
+      reachable += caps_[j];
+      ++open_lines;
+      if (next < 0) next = j;
+    }
+    if (distinct_edges_ + open_lines < options_.min_matches ||
+        assigned_caps_ + reachable < Bound() || InBasin(region) || VerifiedAgain(open_lines)) {
       return;
     }
-    if (next_level < 0) {
+    if (next < 0) {
       VisitLeaf(alive, region);
       return;
     }
-    const Level& level = levels_[next_level];
-    processed_[next_level] = true;
-    for (int c = offsets_[next_level]; c < offsets_[next_level + 1]; ++c) {
-      const int line = candidate_line_[c];
-      if (!alive[c] || used_[line]) continue;
+    for (int c = line_offsets_[next]; c < line_offsets_[next + 1]; ++c) {
+      const int edge = candidate_edge_[c];
+      if (!alive[c] || OverlapsAssigned(edge, next)) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
-      FeasibleRegion& next = regions_[depth + 1];
-      if (!Extend(level.edge, line, region, &next)) continue;
-      next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
-      used_[line] = true;
-      assigned_.emplace_back(level.edge, line);
-      assigned_caps_ += caps_[line];
-      level_assigned_[next_level] = line;
-      ForwardCheck(depth, next, level.edge, line);
-      Search(depth + 1, next);
-      level_assigned_[next_level] = -1;
-      assigned_caps_ -= caps_[line];
+      FeasibleRegion& cut = regions_[depth + 1];
+      if (!Extend(edge, next, region, &cut)) continue;
+      cut.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
+      decided_[next] = c;
+      assigned_.emplace_back(edge, next);
+      assigned_caps_ += caps_[next];
+      distinct_edges_ += edge_lines_[edge]++ == 0 ? 1 : 0;
+      for (size_t b = 0; b < basin_fit_.size(); ++b)
+        basin_fit_[b] += basin_flags_[b][c];
+      ForwardCheck(depth, cut, edge, next);
+      Search(depth + 1, cut);
+      for (size_t b = 0; b < basin_fit_.size(); ++b)
+        basin_fit_[b] -= basin_flags_[b][c];
+      distinct_edges_ -= --edge_lines_[edge] == 0 ? 1 : 0;
+      assigned_caps_ -= caps_[next];
       assigned_.pop_back();
-      used_[line] = false;
+      decided_[next] = kUndecided;
     }
-    level_skipped_[next_level] = true;
+    decided_[next] = kClutter;
     alive_[depth + 1] = alive;
     Search(depth + 1, region);
-    level_skipped_[next_level] = false;
-    processed_[next_level] = false;
+    decided_[next] = kUndecided;
   }
 
-  // Forward checking: the candidates alive at `depth` that stay consistent with `region` after
-  // (edge, line) was assigned there, written to alive_[depth + 1]. Candidates of used lines die.
+  // Forward checking: the candidates of lines not assigned that stay consistent with `region`
+  // after (edge, line) was assigned, written to alive_[depth + 1].
   void ForwardCheck(size_t depth, const FeasibleRegion& region, int edge, int line) {
     const std::vector<char>& in = alive_[depth];
     std::vector<char>& out = alive_[depth + 1];
     const bool vertical = edges_[edge].vertical;
-    for (size_t c = 0; c < candidate_line_.size(); ++c) {
-      out[c] = 0;
-      const int other_line = candidate_line_[c];
-      if (!in[c] || used_[other_line]) continue;
-      const int other_edge = levels_[candidate_level_[c]].edge;
-      const MatchEdge& e = edges_[other_edge];
-      const ObservedLine& l = lines_[other_line];
-      if (e.vertical) {
-        if (vertical && other_edge != edge &&
-            !BinaryVertical(lines_[line], l, AngleRange(edge, other_edge), options_.gate_sigmas)) {
-          continue;
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      const bool assigned = decided_[j] >= 0;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
+        out[c] = 0;
+        if (assigned || !in[c]) continue;
+        const MatchEdge& e = edges_[candidate_edge_[c]];
+        const ObservedLine& l = lines_[j];
+        if (e.vertical) {
+          if (vertical && !BinaryVertical(lines_[line], l, AngleRange(edge, candidate_edge_[c]),
+                                          options_.gate_sigmas)) {
+            continue;
+          }
+          out[c] = MeetsVertical(l, e, options_.gate_sigmas, region) ? 1 : 0;
+        } else {
+          out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
         }
-        out[c] = MeetsVertical(l, e, options_.gate_sigmas, region) ? 1 : 0;
-      } else {
-        out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
       }
     }
+  }
+
+  // True when every leaf below would have most of its pairs fitting a verified pose and no more
+  // lines than it explains (the visitor skips those: they would be verified into it again).
+  // Basins the visitor added since the last node are indexed here first.
+  bool VerifiedAgain(int open_lines) {
+    if (basins_ == nullptr) return false;
+    while (basin_flags_.size() < basins_->size()) {
+      const VerifiedBasin& basin = (*basins_)[basin_flags_.size()];
+      std::vector<char> flags(candidate_edge_.size(), 0);
+      for (size_t c = 0; c < flags.size(); ++c) {
+        flags[c] = std::binary_search(basin.fitting.begin(), basin.fitting.end(),
+                                      std::make_pair(candidate_edge_[c], candidate_line_[c]));
+      }
+      int fit = 0;
+      for (const auto& [e, l] : assigned_)
+        fit += flags[decided_[l]];
+      basin_flags_.push_back(std::move(flags));
+      basin_fit_.push_back(fit);
+    }
+    const int most = static_cast<int>(assigned_.size()) + open_lines;
+    for (size_t b = 0; b < basin_fit_.size(); ++b) {
+      if (most <= (*basins_)[b].lines && 2 * basin_fit_[b] > most) return true;
+    }
+    return false;
   }
 
   // True when the region lies in the basin of a verified pose: its leaves are the same answer.
@@ -244,18 +270,6 @@ class TreeSearch {
       return;
     }
     Hypothesis leaf{assigned_, region, assigned_caps_};
-    // Fragments: unused lines an assigned edge could also take within the region.
-    for (size_t c = 0; c < candidate_line_.size(); ++c) {
-      const int line = candidate_line_[c];
-      if (!alive[c] || used_[line] || line_mark_[line] ||
-          level_assigned_[candidate_level_[c]] < 0) {
-        continue;
-      }
-      line_mark_[line] = true;
-      leaf.bound += caps_[line];
-    }
-    std::fill(line_mark_.begin(), line_mark_.end(), false);
-    if (leaf.bound < Bound()) return;
     std::vector<std::pair<int, int>> key = leaf.pairs;
     std::sort(key.begin(), key.end());
     if (!visited_.insert(std::move(key)).second) return;
@@ -272,42 +286,6 @@ class TreeSearch {
           InscribedAngleRange(edges_[edge1].foot, edges_[edge2].foot, prior_.centre, prior_.radius);
     }
     return *angle_ranges_[key];
-  }
-
-  // Upper bound on what the unprocessed levels can still add: the caps of the unused lines with
-  // a candidate alive at an unprocessed level or at an assigned one (a second fragment).
-  // *open_levels gets the unprocessed levels with an alive candidate, no more than the distinct
-  // lines among them (each line matches one edge); *next_level the one of them with the fewest
-  // (*fewest) alive candidates, -1 when there is none.
-  double Reachable(const std::vector<char>& alive, int* next_level, int* fewest,
-                   int* open_levels) const {
-    double caps = 0.0;
-    int lines = 0;
-    *open_levels = 0;
-    *next_level = -1;
-    for (size_t d = 0; d < levels_.size(); ++d) {
-      const bool open = !processed_[d];
-      if (!open && level_assigned_[d] < 0) continue;
-      int count = 0;
-      for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
-        const int line = candidate_line_[c];
-        if (!alive[c] || used_[line]) continue;
-        ++count;
-        if (line_mark_[line]) continue;
-        line_mark_[line] = true;
-        caps += caps_[line];
-        ++lines;
-      }
-      if (!open || count == 0) continue;
-      ++*open_levels;
-      if (*next_level < 0 || count < *fewest) {
-        *next_level = static_cast<int>(d);
-        *fewest = count;
-      }
-    }
-    std::fill(line_mark_.begin(), line_mark_.end(), false);
-    *open_levels = std::min(*open_levels, lines);
-    return caps;
   }
 
   // True when the extension keeps most of the region (at least half of its heading bins and a
@@ -330,16 +308,15 @@ class TreeSearch {
     return true;
   }
 
-  // A leaf is kept only when no skipped edge could have been matched as well in every pose
-  // cluster: every subset of a consistent assignment is consistent, and verifying those again
-  // would be wasted work.
+  // A leaf is kept only when no line left as clutter could have been assigned as well in every
+  // pose cluster: every subset of a consistent assignment is consistent, and verifying those
+  // again would be wasted work.
   bool IsMaximal(const std::vector<char>& alive, const FeasibleRegion& region) const {
-    for (size_t d = 0; d < levels_.size(); ++d) {
-      if (!level_skipped_[d]) continue;
-      for (int c = offsets_[d]; c < offsets_[d + 1]; ++c) {
-        const int line = candidate_line_[c];
-        if (!alive[c] || used_[line]) continue;
-        if (Extend(levels_[d].edge, line, region, &maximal_scratch_) &&
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      if (decided_[j] != kClutter) continue;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
+        if (!alive[c] || OverlapsAssigned(candidate_edge_[c], static_cast<int>(j))) continue;
+        if (Extend(candidate_edge_[c], static_cast<int>(j), region, &maximal_scratch_) &&
             KeepsEveryCluster(region, maximal_scratch_)) {
           return false;
         }
@@ -357,16 +334,14 @@ class TreeSearch {
   const std::vector<VerifiedBasin>* basins_;
   Gate gate_;
   std::vector<double> caps_;
-  std::vector<Level> levels_;
-  // All candidates flattened by level: their level and line.
-  std::vector<int> offsets_, candidate_level_, candidate_line_;
+  std::vector<int> order_;  // lines by decreasing cap
+  // Candidates by line: line j holds [line_offsets_[j], line_offsets_[j + 1]).
+  std::vector<int> line_offsets_, candidate_edge_, candidate_line_;
   // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
   std::vector<std::vector<char>> alive_;
-  std::vector<bool> used_;
-  std::vector<int> level_assigned_;      // line assigned at each level on the current branch, or -1
-  std::vector<bool> level_skipped_;      // levels skipped on the current branch
-  std::vector<bool> processed_;          // levels assigned or skipped on the current branch
-  mutable std::vector<bool> line_mark_;  // scratch: lines counted once
+  std::vector<int> decided_;     // per line: assigned candidate, kUndecided or kClutter
+  std::vector<int> edge_lines_;  // per edge: lines assigned on the current branch
+  int distinct_edges_ = 0;
   std::vector<FeasibleRegion> regions_;  // per depth
   mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
@@ -374,6 +349,9 @@ class TreeSearch {
   double pass_bound_ = 0.0;
   double visitor_bound_ = 0.0;
   std::set<std::vector<std::pair<int, int>>> visited_;
+  // Per basin: which candidates fit its pose, and how many assigned pairs do.
+  std::vector<std::vector<char>> basin_flags_;
+  std::vector<int> basin_fit_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };
 

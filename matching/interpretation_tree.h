@@ -57,12 +57,16 @@ struct Hypothesis {
   double bound = 0.0;
 };
 
-// A pose already verified and the neighbourhood in which any pose is the same answer: subtrees
-// whose region lies inside it, and leaves whose region holds the pose, are not explored again.
+// A pose already verified and what would be verified into it again: subtrees whose region lies
+// in its neighbourhood (radius_m, heading_rad), leaves whose region holds the pose, and subtrees
+// all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
+// pose) and no more lines than it explains.
 struct VerifiedBasin {
   Pose3Dof pose;
   double radius_m = 0.0;
   double heading_rad = 0.0;
+  int lines = 0;                             // lines the verified pose explains
+  std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
 };
 
 struct InterpretationTreeStats {

@@ -125,11 +125,15 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
               return bound;
             }
           }
-          for (const VerifiedPose& v : verified) {
-            // Mostly fitting a verified pose that explains at least as many edges: verified into
-            // it again (leaves hold one line per edge).
-            if (v.plausible && static_cast<int>(h.pairs.size()) <= v.matched_edges &&
-                2 * PairsFitting(context, vo, h.pairs, v) > static_cast<int>(h.pairs.size())) {
+          // Mostly fitting a verified pose that explains at least as many lines: verified into
+          // it again.
+          for (const VerifiedBasin& b : basins) {
+            const int fit =
+                static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+                  return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
+                }));
+            if (static_cast<int>(h.pairs.size()) <= b.lines &&
+                2 * fit > static_cast<int>(h.pairs.size())) {
               return bound;
             }
           }
@@ -140,9 +144,12 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
           if (v.plausible) {
             CompleteEvidence(context, vo, &v);
             best = std::max(best, v.evidence.Score());
-            // Any pose within basin_sigmas standard deviations is this answer again.
+            // Leaves that would be verified into this pose again are not verified: those whose
+            // region holds it or lies within basin_sigmas of its standard deviations, and those
+            // most of whose pairs fit it.
             basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
-                              vo.basin_sigmas * v.refinement.heading_sigma_rad});
+                              vo.basin_sigmas * v.refinement.heading_sigma_rad,
+                              static_cast<int>(v.pairs.size()), FittingPairs(context, vo, v)});
           }
           std::vector<std::pair<int, int>> pairs = v.pairs;
           std::sort(pairs.begin(), pairs.end());

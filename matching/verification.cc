@@ -402,16 +402,32 @@ bool TrimHypothesis(const VerificationContext& context, const VerificationOption
   return true;
 }
 
-int PairsFitting(const VerificationContext& context, const VerificationOptions& options,
-                 const std::vector<std::pair<int, int>>& pairs, const VerifiedPose& verified) {
-  int count = 0;
-  for (const LineMatch& m : ToLineMatches(context, pairs)) {
-    const Eigen::Vector2d r =
-        m.whitening * EndpointResiduals(m, *context.camera, context.height, context.tilt,
-                                        verified.pose, verified.refinement.focal_scale, nullptr);
-    count += r.squaredNorm() <= options.gate_chi2 ? 1 : 0;
+std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+                                              const VerificationOptions& options,
+                                              const VerifiedPose& verified) {
+  const double sigma_theta = DegToRad(context.noise.angle_deg);
+  std::vector<Eigen::Matrix2d> whitening;
+  for (const ObservedLine& line : *context.lines) {
+    const double half = 0.5 * line.length_px;
+    whitening.push_back(
+        Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta)));
   }
-  return count;
+  std::vector<std::pair<int, int>> fitting;
+  for (size_t e = 0; e < context.edges->size(); ++e) {
+    const MatchEdge& edge = (*context.edges)[e];
+    const Eigen::Vector3d image_line =
+        ProjectedEdgeLine(edge.a, edge.b, *context.camera, context.height, context.tilt,
+                          verified.pose, verified.refinement.focal_scale, nullptr);
+    for (size_t l = 0; l < context.lines->size(); ++l) {
+      const Segment2& s = (*context.lines)[l].pixels;
+      const Eigen::Vector2d r(image_line.dot(Eigen::Vector3d(s.a.x(), s.a.y(), 1.0)),
+                              image_line.dot(Eigen::Vector3d(s.b.x(), s.b.y(), 1.0)));
+      if ((whitening[l] * r).squaredNorm() <= options.gate_chi2) {
+        fitting.emplace_back(static_cast<int>(e), static_cast<int>(l));
+      }
+    }
+  }
+  return fitting;
 }
 
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,

@@ -130,11 +130,12 @@ bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOpti
 bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
                     VerifiedPose* hypothesis);
 
-// How many of `pairs` fit the verified pose (whitened endpoint residuals at its pose and focal
-// scale within gate_chi2). A hypothesis most of whose pairs fit a verified pose would be
-// verified into it again.
-int PairsFitting(const VerificationContext& context, const VerificationOptions& options,
-                 const std::vector<std::pair<int, int>>& pairs, const VerifiedPose& verified);
+// Every (edge index, line index) pair that fits the verified pose: whitened endpoint residuals
+// at its pose and focal scale within gate_chi2 (sorted). A hypothesis most of whose pairs fit a
+// verified pose would be verified into it again.
+std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+                                              const VerificationOptions& options,
+                                              const VerifiedPose& verified);
 
 // Guided matching from `start` (options.guided_rounds rounds of assignment and re-estimation),
 // then the plausibility checks and the lines term of the evidence.
