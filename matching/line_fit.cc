@@ -23,8 +23,7 @@ double EndpointAlongDensity(double t, double length, double sigma, double end_pr
 
 double MaxLogLikelihoodRatio(double length, const LineFitModel& model) {
   const double d = model.image_diagonal_px;
-  // The projected piece may be shorter than the segment by the overhang tolerance at each end.
-  const double piece = std::max(length - 2.0 * model.extent_sigmas * model.offset_px, 1.0);
+  const double piece = std::max(length, 1.0);
   const double end_sigma = std::hypot(model.end_shortening * piece, model.offset_px);
   return std::log(d / (2.0 * model.offset_px * model.angle_rad)) +
          2.0 * std::log(d * EndpointAlongDensity(0.0, piece, end_sigma, model.end_probability));

@@ -110,7 +110,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     const LineFitModel fit_model = FitModel(context, vo);
     std::vector<double> caps;
     for (const ObservedLine& line : lines)
-      caps.push_back(MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density);
+      caps.push_back(vo.cap_efficiency *
+                     (MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density));
     double best = -std::numeric_limits<double>::infinity();
     std::vector<std::vector<std::pair<int, int>>> verified_pairs;
     std::vector<VerifiedBasin> basins;
@@ -139,7 +140,10 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
           }
           ++result.hypotheses;
           VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
-          if (!TrimHypothesis(context, vo, &leaf)) return bound;
+          if (!TrimHypothesis(context, vo, &leaf) ||
+              HypothesisEvidence(context, vo, leaf) < bound) {
+            return bound;
+          }
           VerifiedPose v = Rematch(context, leaf, vo);
           if (v.plausible) {
             CompleteEvidence(context, vo, &v);

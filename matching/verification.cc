@@ -402,6 +402,21 @@ bool TrimHypothesis(const VerificationContext& context, const VerificationOption
   return true;
 }
 
+double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
+                          const VerifiedPose& hypothesis) {
+  const std::vector<EdgeImage> images =
+      ProjectEdges(context, hypothesis.pose, hypothesis.refinement.focal_scale);
+  const LineFitModel model = FitModel(context, options);
+  double total = 0.0;
+  for (const auto& [e, l] : hypothesis.pairs) {
+    if (!images[e].visible) continue;
+    const LineFit fit =
+        FitLine(images[e].image, (*context.lines)[l].pixels, Eigen::Matrix2d::Zero(), model);
+    total += std::max(0.0, fit.log_likelihood_ratio - (*context.lines)[l].clutter_log_density);
+  }
+  return total;
+}
+
 std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
                                               const VerificationOptions& options,
                                               const VerifiedPose& verified) {
