@@ -228,7 +228,7 @@ class TreeSearch {
     }
   }
 
-  // True when every leaf below would have most of its pairs fitting a verified pose and no more
+  // True when every leaf below would have most of its pairs fitting a verified pose and fewer
   // lines than it explains (the visitor skips those: they would be verified into it again).
   // Basins the visitor added since the last node are indexed here first.
   bool VerifiedAgain(int open_lines) {
@@ -248,7 +248,7 @@ class TreeSearch {
     }
     const int most = static_cast<int>(assigned_.size()) + open_lines;
     for (size_t b = 0; b < basin_fit_.size(); ++b) {
-      if (most <= (*basins_)[b].lines && 2 * basin_fit_[b] > most) return true;
+      if (most < (*basins_)[b].lines && 2 * basin_fit_[b] > most) return true;
     }
     return false;
   }

@@ -60,7 +60,7 @@ struct Hypothesis {
 // A pose already verified and what would be verified into it again: subtrees whose region lies
 // in its neighbourhood (radius_m, heading_rad), leaves whose region holds the pose, and subtrees
 // all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
-// pose) and no more lines than it explains.
+// pose) and fewer lines than it explains.
 struct VerifiedBasin {
   Pose3Dof pose;
   double radius_m = 0.0;

@@ -30,7 +30,8 @@ double MaxLogLikelihoodRatio(double length, const LineFitModel& model) {
 }
 
 LineFit FitLine(const Segment2& projected, const Segment2& observed,
-                const Eigen::Matrix2d& pose_term, const LineFitModel& model) {
+                const Eigen::Matrix2d& pose_term, const LineFitModel& model,
+                const Eigen::Vector2d& end_variance) {
   LineFit fit;
   const Eigen::Vector2d axis = projected.b - projected.a;
   const double lambda = axis.norm();
@@ -50,9 +51,11 @@ LineFit FitLine(const Segment2& projected, const Segment2& observed,
   const double det = fit.covariance.determinant();
   if (!(det > 0.0)) return fit;
   fit.chi2 = fit.residuals.dot(fit.covariance.inverse() * fit.residuals);
-  // Endpoint position noise along the edge, taken as the perpendicular one's.
-  const double position_sigma = std::sqrt(0.5 * fit.covariance.trace());
-  const double end_sigma = std::hypot(model.end_shortening * lambda, position_sigma);
+  // Position noise of the projection's ends along it: the line noise (sigma_d) and the pose.
+  const double d2 = model.offset_px * model.offset_px;
+  const double sigma_a = std::sqrt(d2 + end_variance.x()),
+               sigma_b = std::sqrt(d2 + end_variance.y());
+  const double end_sigma = std::hypot(model.end_shortening * lambda, std::max(sigma_a, sigma_b));
   const double along =
       std::log(model.image_diagonal_px *
                EndpointAlongDensity(s_a, lambda, end_sigma, model.end_probability)) +
@@ -60,8 +63,8 @@ LineFit FitLine(const Segment2& projected, const Segment2& observed,
                EndpointAlongDensity(s_b, lambda, end_sigma, model.end_probability));
   fit.log_likelihood_ratio =
       std::log(model.image_diagonal_px * length / (2.0 * std::sqrt(det))) - 0.5 * fit.chi2 + along;
-  fit.gated =
-      fit.chi2 <= model.gate_chi2 && fit.overhang_px <= model.extent_sigmas * position_sigma;
+  fit.gated = fit.chi2 <= model.gate_chi2 && -fit.lo <= model.extent_sigmas * sigma_a &&
+              fit.hi - lambda <= model.extent_sigmas * sigma_b;
   return fit;
 }
 

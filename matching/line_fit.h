@@ -59,8 +59,11 @@ double EndpointAlongDensity(double t, double length, double sigma, double end_pr
 double MaxLogLikelihoodRatio(double length, const LineFitModel& model);
 
 // The fit of `observed` to `projected` (pixels). `pose_term` is the residual covariance the pose
-// uncertainty adds (J C J^T, J = d residuals / d pose), zero for a known pose.
+// uncertainty adds (J C J^T, J = d residuals / d pose), zero for a known pose; `end_variance` the
+// variance (pixels^2) the pose uncertainty gives the positions of projected.a and projected.b
+// along the projection.
 LineFit FitLine(const Segment2& projected, const Segment2& observed,
-                const Eigen::Matrix2d& pose_term, const LineFitModel& model);
+                const Eigen::Matrix2d& pose_term, const LineFitModel& model,
+                const Eigen::Vector2d& end_variance = Eigen::Vector2d::Zero());
 
 }  // namespace linetrack

@@ -126,15 +126,15 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
               return bound;
             }
           }
-          // Mostly fitting a verified pose that explains at least as many lines: verified into
-          // it again.
+          // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
+          // explains as many: verified into it again.
           for (const VerifiedBasin& b : basins) {
             const int fit =
                 static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
                   return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
                 }));
-            if (static_cast<int>(h.pairs.size()) <= b.lines &&
-                2 * fit > static_cast<int>(h.pairs.size())) {
+            const int size = static_cast<int>(h.pairs.size());
+            if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
               return bound;
             }
           }

@@ -56,7 +56,44 @@ struct EdgeImage {
   Segment3 world;
   Eigen::Vector3d line;
   Eigen::Matrix<double, 3, 4> d_line;
+  // d image.a / d (heading, x, y, scale) and the same for image.b.
+  Eigen::Matrix<double, 2, 4> d_start, d_end;
+
+  // Variances along the image of its two ends for the pose covariance `c`.
+  Eigen::Vector2d EndVariance(const Eigen::Matrix4d& c) const {
+    const Eigen::Vector2d u = (image.b - image.a).normalized();
+    const Eigen::Vector4d ja = d_start.transpose() * u, jb = d_end.transpose() * u;
+    return {ja.dot(c * ja), jb.dot(c * jb)};
+  }
 };
+
+// Pixel of world point `p` seen from `pose` with focal lengths scaled by `scale`.
+Eigen::Vector2d ProjectPoint(const VerificationContext& context, const Pose3Dof& pose, double scale,
+                             const Eigen::Vector3d& p) {
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  return ScaledCamera(*context.camera, scale).Project(cam_from_world * p);
+}
+
+// d pixel(p) / d (heading, x, y, scale) by central differences.
+Eigen::Matrix<double, 2, 4> ProjectionJacobian(const VerificationContext& context,
+                                               const Pose3Dof& pose, double scale,
+                                               const Eigen::Vector3d& p) {
+  constexpr double kStep = 1e-6;
+  Eigen::Matrix<double, 2, 4> j;
+  for (int k = 0; k < 4; ++k) {
+    Pose3Dof plus = pose, minus = pose;
+    double s_plus = scale, s_minus = scale;
+    double* fields[4][2] = {{&plus.heading, &minus.heading},
+                            {&plus.x, &minus.x},
+                            {&plus.y, &minus.y},
+                            {&s_plus, &s_minus}};
+    *fields[k][0] += kStep;
+    *fields[k][1] -= kStep;
+    j.col(k) = (ProjectPoint(context, plus, s_plus, p) - ProjectPoint(context, minus, s_minus, p)) /
+               (2.0 * kStep);
+  }
+  return j;
+}
 
 std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
                                     double focal_scale) {
@@ -74,6 +111,8 @@ std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Po
     image.visible = true;
     image.line = ProjectedEdgeLine(edge.a, edge.b, *context.camera, context.height, context.tilt,
                                    pose, focal_scale, &image.d_line);
+    image.d_start = ProjectionJacobian(context, pose, focal_scale, image.world.a);
+    image.d_end = ProjectionJacobian(context, pose, focal_scale, image.world.b);
   }
   return out;
 }
@@ -143,7 +182,8 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
       Eigen::Matrix<double, 2, 4> j;
       j.row(0) = qa.transpose() * image.d_line;
       j.row(1) = qb.transpose() * image.d_line;
-      LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model);
+      LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model,
+                            image.EndVariance(pose_covariance));
       fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
       if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
       if (context.occlusion != nullptr &&
@@ -366,7 +406,9 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
 
 bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
                     VerifiedPose* hypothesis) {
-  if (!ConsistentHypothesis(*hypothesis, options)) {
+  if (ConsistentHypothesis(*hypothesis, options)) return true;
+  const std::vector<std::pair<int, int>> original = hypothesis->pairs;
+  {
     // A leaf holding wrong pairs: restart from the pairs that agree with a minimal pose.
     Pose3Dof start;
     std::vector<std::pair<int, int>> agreeing =
@@ -398,6 +440,30 @@ bool TrimHypothesis(const VerificationContext& context, const VerificationOption
                                         context.height, context.tilt, hypothesis->pose,
                                         hypothesis->refinement.focal_scale, options.refinement);
     hypothesis->pose = hypothesis->refinement.pose;
+  }
+  // Pairs dropped on the way that fit the consistent pose are taken back (the minimal pose of the
+  // consensus is rough), as long as the hypothesis stays consistent.
+  for (int round = 0; round < 2; ++round) {
+    VerifiedPose trial = *hypothesis;
+    const std::vector<LineMatch> matches = ToLineMatches(context, original);
+    for (size_t i = 0; i < original.size(); ++i) {
+      if (std::find(trial.pairs.begin(), trial.pairs.end(), original[i]) != trial.pairs.end()) {
+        continue;
+      }
+      const double chi2 =
+          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
+                                                    context.tilt, hypothesis->pose,
+                                                    hypothesis->refinement.focal_scale, nullptr))
+              .squaredNorm();
+      if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
+    }
+    if (trial.pairs.size() == hypothesis->pairs.size()) break;
+    trial.refinement = RefinePose(ToLineMatches(context, trial.pairs), *context.camera,
+                                  context.height, context.tilt, hypothesis->pose,
+                                  hypothesis->refinement.focal_scale, options.refinement);
+    trial.pose = trial.refinement.pose;
+    if (!ConsistentHypothesis(trial, options)) break;
+    *hypothesis = std::move(trial);
   }
   return true;
 }
