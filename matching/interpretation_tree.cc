@@ -1,5 +1,7 @@
 #include "matching/interpretation_tree.h"
 
+#include "matching/line_fit.h"
+
 #include <algorithm>
 #include <numeric>
 #include <optional>
@@ -74,6 +76,7 @@ class TreeSearch {
  private:
   static constexpr int kUndecided = -1;
   static constexpr int kClutter = -2;
+  static constexpr double kFragmentGateChi2 = 13.8;  // 99.9 % of chi-square with 2 dof
 
   // Unary constraints: each line against the non-vertical edges and, when it can be the image of
   // a vertical edge, against the vertical ones. Lines are searched by decreasing cap (long lines
@@ -106,8 +109,8 @@ class TreeSearch {
     stats_->unary_candidates = static_cast<int>(candidate_edge_.size());
   }
 
-  // True when `line` overlaps (beyond the noise) a line already assigned to `edge`: fragments of
-  // one edge do not overlap.
+  // True when `line` cannot be a further fragment of `edge`'s image: it overlaps (beyond the
+  // slack) a line already assigned to it, or does not lie on the same line.
   bool OverlapsAssigned(int edge, int line) const {
     if (edge_lines_[edge] == 0) return false;
     const Segment2& s = lines_[line].pixels;
@@ -119,7 +122,10 @@ class TreeSearch {
       const double t0 = (t.a - s.a).dot(axis), t1 = (t.b - s.a).dot(axis);
       const double overlap =
           std::min(std::max(t0, t1), s.Length()) - std::max(std::min(t0, t1), 0.0);
-      if (overlap > tolerance) return true;
+      if (overlap > tolerance ||
+          FragmentChiSquare(t, s, options_.fragment_offset_px) > kFragmentGateChi2) {
+        return true;
+      }
     }
     return false;
   }

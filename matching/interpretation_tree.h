@@ -27,6 +27,9 @@ struct InterpretationTreeOptions {
   double heading_bin_deg = 0.75;      // finest heading bins of the feasible region (degrees)
   int max_bins = 96;                  // bins are split finer as the headings narrow, up to this
   int min_matches = 4;                // k: leaves with fewer correspondences are discarded
+  // Lines assigned to one edge are fragments: they may not overlap (beyond extent_slack_px) and
+  // must lie on one line (FragmentChiSquare with this offset noise, pixels, below 13.8).
+  double fragment_offset_px = 1.0;
   // Iterative deepening: each pass lowers the bound by this many lines' worth of caps.
   double deepening_lines = 2.0;
   int max_nodes = 20000;     // search budget (deterministic), over all passes

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace linetrack {
 
@@ -27,6 +28,18 @@ double MaxLogLikelihoodRatio(double length, const LineFitModel& model) {
   const double end_sigma = std::hypot(model.end_shortening * piece, model.offset_px);
   return std::log(d / (2.0 * model.offset_px * model.angle_rad)) +
          2.0 * std::log(d * EndpointAlongDensity(0.0, piece, end_sigma, model.end_probability));
+}
+
+double FragmentChiSquare(const Segment2& reference, const Segment2& fragment, double sigma) {
+  const double length = reference.Length();
+  if (length < 1e-9 || !(sigma > 0.0)) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d u = (reference.b - reference.a) / length, n(-u.y(), u.x());
+  const Eigen::Vector2d mid = reference.Mid();
+  const Eigen::Vector2d r(n.dot(fragment.a - mid), n.dot(fragment.b - mid));
+  const double ta = u.dot(fragment.a - mid) / length, tb = u.dot(fragment.b - mid) / length;
+  Eigen::Matrix2d c;
+  c << 1.5 + 2.0 * ta * ta, 0.5 + 2.0 * ta * tb, 0.5 + 2.0 * ta * tb, 1.5 + 2.0 * tb * tb;
+  return r.dot((sigma * sigma * c).inverse() * r);
 }
 
 LineFit FitLine(const Segment2& projected, const Segment2& observed,

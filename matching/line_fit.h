@@ -58,6 +58,12 @@ double EndpointAlongDensity(double t, double length, double sigma, double end_pr
 // chi2 = 0, no pose uncertainty, both endpoints at the ends of a piece of about its length.
 double MaxLogLikelihoodRatio(double length, const LineFitModel& model);
 
+// Chi-square (2 dof) of `fragment` lying on the line of `reference` when both are pieces of one
+// detected line whose endpoints carry independent N(0, sigma) offsets: the reference's line is
+// extrapolated (offset variance sigma^2 (1/2 + 2 t^2 / L^2) at t from its middle, L its length)
+// and the fragment's endpoints add sigma^2 each.
+double FragmentChiSquare(const Segment2& reference, const Segment2& fragment, double sigma);
+
 // The fit of `observed` to `projected` (pixels). `pose_term` is the residual covariance the pose
 // uncertainty adds (J C J^T, J = d residuals / d pose), zero for a known pose; `end_variance` the
 // variance (pixels^2) the pose uncertainty gives the positions of projected.a and projected.b

@@ -53,6 +53,7 @@ Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* re
   if (options_.verification.refinement.focal_prior_sigma == 0.0) {
     options_.verification.refinement.focal_prior_sigma = options_.noise.focal_relative;
   }
+  options_.tree.fragment_offset_px = options_.noise.fragment_offset_px;
   std::string why;
   if (!options_.Check(&why)) throw InputError("localizer options: " + why);
   if (!camera_.Check(&why)) throw InputError("camera: " + why);

@@ -8,7 +8,7 @@
 namespace linetrack {
 
 bool LineNoise::Check(std::string* why) const {
-  const double values[] = {offset_px, angle_deg, focal_relative, tilt_deg};
+  const double values[] = {offset_px, angle_deg, focal_relative, tilt_deg, fragment_offset_px};
   for (double v : values) {
     if (!std::isfinite(v) || v < 0.0) {
       *why = "line noise values must be finite and >= 0";

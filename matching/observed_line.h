@@ -17,6 +17,9 @@ struct LineNoise {
   double angle_deg = 1.0;        // std of the line's angle about its midpoint (degrees)
   double focal_relative = 0.02;  // std of the relative focal-length error (calibration)
   double tilt_deg = 0.0;         // std of the tilt reading (head encoder)
+  // Pieces of one detected line (fragments of an edge's image) lie on one line up to this
+  // offset of their endpoints (pixels).
+  double fragment_offset_px = 1.0;
   // Share of the clutter lines that image unmodelled vertical structures (furniture legs,
   // poles, stands): they pass through the vertical vanishing point like the images of vertical
   // model edges, so clutter is denser there (1/3 in the synthetic scenes, docs/synth.md).

@@ -218,8 +218,13 @@ Assignment Assign(const VerificationContext& context, std::vector<Candidate> can
   std::vector<bool> line_used(context.lines->size(), false);
   for (const Candidate& c : candidates) {
     if (line_used[c.line]) continue;
+    // Fragments of one edge's image do not overlap and lie on one line.
+    const Segment2& piece = (*context.lines)[c.line].pixels;
     const bool blocked = std::any_of(out.assigned.begin(), out.assigned.end(), [&](const auto& a) {
-      return a.edge == c.edge && Overlap(a.fit, c.fit, overlap_tolerance);
+      return a.edge == c.edge &&
+             (Overlap(a.fit, c.fit, overlap_tolerance) ||
+              FragmentChiSquare((*context.lines)[a.line].pixels, piece,
+                                context.noise.fragment_offset_px) > options.gate_chi2);
     });
     if (blocked) continue;
     line_used[c.line] = true;
