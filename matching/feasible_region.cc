@@ -122,7 +122,19 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
     const double hi = heading.lo + heading.Width() * (i + 1) / count;
     region.bins.push_back({lo, hi, Trig(lo), Trig(0.5 * (lo + hi)), Trig(hi), disk});
   }
+  region.UpdateBox();
   return region;
+}
+
+void FeasibleRegion::UpdateBox() {
+  box_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  box_hi = -box_lo;
+  for (const HeadingBin& bin : bins) {
+    for (const Eigen::Vector2d& q : bin.positions) {
+      box_lo = box_lo.cwiseMin(q);
+      box_hi = box_hi.cwiseMax(q);
+    }
+  }
 }
 
 bool FeasibleRegion::Contains(const Pose3Dof& pose) const {
@@ -142,13 +154,13 @@ bool FeasibleRegion::Contains(const Pose3Dof& pose) const {
 
 bool FeasibleRegion::Within(const Pose3Dof& pose, double radius, double heading_margin) const {
   if (bins.empty()) return false;
+  // The bins' headings run continuously: bring the pose's heading next to them once.
+  const double h =
+      pose.heading + 2.0 * kPi * std::round((bins.front().lo - pose.heading) / (2.0 * kPi));
+  if (bins.front().lo < h - heading_margin || bins.back().hi > h + heading_margin) return false;
   const double r2 = radius * radius;
   const Eigen::Vector2d q(pose.x, pose.y);
   for (const HeadingBin& bin : bins) {
-    if (std::abs(WrapAngle(bin.lo - pose.heading)) > heading_margin ||
-        std::abs(WrapAngle(bin.hi - pose.heading)) > heading_margin) {
-      return false;
-    }
     for (const Eigen::Vector2d& v : bin.positions) {
       if ((v - q).squaredNorm() > r2) return false;
     }
@@ -217,64 +229,43 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
           slack};
 }
 
-// The wedges of camera positions a vertical correspondence allows: for a bin, the camera
-// directions from the foot are (h - w) + pi for h in the bin, widened by the margin -- from
-// bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
-class VerticalWedges {
- public:
-  VerticalWedges(const ObservedLine& line, const MatchEdge& edge, double sigmas)
-      : foot_(edge.foot),
-        margin_(sigmas * line.bearing_sigma),
-        a_(Trig(-line.bearing - margin_ + kPi)),
-        b_(Trig(-line.bearing + margin_ + kPi)) {}
+}  // namespace
 
-  // The wedge in `bin`: n1 . q + d1 >= 0 and n2 . q + d2 >= 0; false when the bin is too wide
-  // for a wedge (everything allowed).
-  bool In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-          double* d2) const {
-    if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
-    auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-      return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-    };
-    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
-    *n1 = Eigen::Vector2d(-u1.y(), u1.x());
-    *n2 = Eigen::Vector2d(u2.y(), -u2.x());
-    *d1 = -n1->dot(foot_);
-    *d2 = -n2->dot(foot_);
-    return true;
-  }
+VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double sigmas)
+    : foot_(edge.foot),
+      bearing_(line.bearing),
+      margin_(sigmas * line.bearing_sigma),
+      a_(Trig(-line.bearing - margin_ + kPi)),
+      b_(Trig(-line.bearing + margin_ + kPi)) {}
 
- private:
-  Eigen::Vector2d foot_;
-  double margin_;
-  Eigen::Vector2d a_, b_;
-};
+bool VerticalCut::In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
+                     double* d2) const {
+  if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
+  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+  };
+  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
+  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+  *d1 = -n1->dot(foot_);
+  *d2 = -n2->dot(foot_);
+  return true;
+}
 
-// Quick reject of a vertical correspondence: the directions from the foot to the region's
-// bounding box must meet the camera directions the headings allow.
-bool VerticalMayMeet(const ObservedLine& line, const MatchEdge& edge, double sigmas,
-                     const FeasibleRegion& in) {
-  const double margin = sigmas * line.bearing_sigma;
-  if (in.Empty() || in.Heading().Width() + 2.0 * margin >= kPi) return !in.Empty();
-  Eigen::Vector2d lo = *in.bins.front().positions.begin(), hi = lo;
-  for (const HeadingBin& bin : in.bins) {
-    for (const Eigen::Vector2d& q : bin.positions) {
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
-  }
-  const Eigen::Vector2d centre = 0.5 * (lo + hi);
-  const double reach = 0.5 * (hi - lo).norm();
-  const Eigen::Vector2d to_box = centre - edge.foot;
+bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
+  if (in.Empty()) return false;
+  const HeadingInterval heading = in.Heading();
+  if (heading.Width() + 2.0 * margin_ >= kPi) return true;
+  const Eigen::Vector2d centre = 0.5 * (in.box_lo + in.box_hi);
+  const double reach = 0.5 * (in.box_hi - in.box_lo).norm();
+  const Eigen::Vector2d to_box = centre - foot_;
   const double distance = to_box.norm();
   if (distance <= reach) return true;
   const double spread = std::asin(reach / distance);
-  const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
+  const double wanted = heading.Mid() - bearing_ + kPi;
   const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
-  return offset <= spread + 0.5 * in.Heading().Width() + margin;
+  return offset <= spread + 0.5 * heading.Width() + margin_;
 }
-
-}  // namespace
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     const FeasibleRegion& in, FeasibleRegion* out) {
@@ -291,6 +282,7 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
                            band.half_width + band.offset);
     if (cut.positions.Empty()) out->bins.pop_back();
   }
+  out->UpdateBox();
   return !out->Empty();
 }
 
@@ -314,34 +306,36 @@ bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double he
   return false;
 }
 
-bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
-                 const FeasibleRegion& in, FeasibleRegion* out) {
+bool AddVertical(const VerticalCut& cut, const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
-  if (!VerticalMayMeet(line, edge, sigmas, in)) return false;
-  const VerticalWedges wedges(line, edge, sigmas);
+  if (!cut.MayMeet(in)) return false;
   for (const HeadingBin& bin : in.bins) {
-    HeadingBin& cut = Append(bin, out);
+    HeadingBin& kept = Append(bin, out);
     Eigen::Vector2d n1, n2;
     double d1 = 0.0, d2 = 0.0;
-    if (!wedges.In(bin, &n1, &d1, &n2, &d2)) {
-      cut.positions = bin.positions;
+    if (!cut.In(bin, &n1, &d1, &n2, &d2)) {
+      kept.positions = bin.positions;
       continue;
     }
-    cut.positions.ClipFrom(bin.positions, n1, d1, n2, d2);
-    if (cut.positions.Empty()) out->bins.pop_back();
+    kept.positions.ClipFrom(bin.positions, n1, d1, n2, d2);
+    if (kept.positions.Empty()) out->bins.pop_back();
   }
+  out->UpdateBox();
   return !out->Empty();
 }
 
-bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
-                   const FeasibleRegion& region) {
-  if (!VerticalMayMeet(line, edge, sigmas, region)) return false;
-  const VerticalWedges wedges(line, edge, sigmas);
+bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                 const FeasibleRegion& in, FeasibleRegion* out) {
+  return AddVertical(VerticalCut(line, edge, sigmas), in, out);
+}
+
+bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region) {
+  if (region.bins.size() > 4 && !cut.MayMeet(region)) return false;
   ConvexPolygon scratch;
   for (const HeadingBin& bin : region.bins) {
     Eigen::Vector2d n1, n2;
     double d1 = 0.0, d2 = 0.0;
-    if (!wedges.In(bin, &n1, &d1, &n2, &d2)) return true;
+    if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
     // Quick answers before clipping: every vertex outside one half-plane (no), or inside both
     // (yes).
     bool all_in = true, any_in1 = false, any_in2 = false;
@@ -357,6 +351,11 @@ bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigma
     if (!scratch.Empty()) return true;
   }
   return false;
+}
+
+bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const FeasibleRegion& region) {
+  return MeetsVertical(VerticalCut(line, edge, sigmas), region);
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,

@@ -48,6 +48,7 @@ class TreeSearch {
         bin.positions.ClipHalfPlane({0.0, -1.0}, prior_.bounds_max.y());
       }
       if (root.bins.front().positions.Empty()) return;
+      root.UpdateBox();
     }
     const size_t n = lines_.size();
     decided_.assign(n, kUndecided);
@@ -103,6 +104,10 @@ class TreeSearch {
         if (!pass) continue;
         candidate_edge_.push_back(static_cast<int>(e));
         candidate_line_.push_back(static_cast<int>(j));
+        cuts_.push_back(edges_[e].vertical
+                            ? std::optional<VerticalCut>(std::in_place, lines_[j], edges_[e],
+                                                         options_.gate_sigmas)
+                            : std::nullopt);
       }
       line_offsets_.push_back(static_cast<int>(candidate_edge_.size()));
     }
@@ -132,7 +137,8 @@ class TreeSearch {
 
   // Writes `in` cut by (edge, line) into `out`; false when the pose set becomes empty or a binary
   // vertical constraint with an assigned vertical correspondence fails.
-  bool Extend(int edge, int line, const FeasibleRegion& in, FeasibleRegion* out) const {
+  bool Extend(int c, const FeasibleRegion& in, FeasibleRegion* out) const {
+    const int edge = candidate_edge_[c], line = candidate_line_[c];
     const MatchEdge& e = edges_[edge];
     const ObservedLine& l = lines_[line];
     if (!e.vertical) return AddNonVertical(l, e, prior_.height, options_.gate_sigmas, in, out);
@@ -145,7 +151,7 @@ class TreeSearch {
         return false;
       }
     }
-    return AddVertical(l, e, options_.gate_sigmas, in, out);
+    return AddVertical(*cuts_[c], in, out);
   }
 
   double Bound() const { return std::max(pass_bound_, visitor_bound_); }
@@ -185,7 +191,7 @@ class TreeSearch {
       if (!alive[c] || OverlapsAssigned(edge, next)) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
       FeasibleRegion& cut = regions_[depth + 1];
-      if (!Extend(edge, next, region, &cut)) continue;
+      if (!Extend(c, region, &cut)) continue;
       cut.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
       decided_[next] = c;
       assigned_.emplace_back(edge, next);
@@ -226,7 +232,7 @@ class TreeSearch {
                                           options_.gate_sigmas)) {
             continue;
           }
-          out[c] = MeetsVertical(l, e, options_.gate_sigmas, region) ? 1 : 0;
+          out[c] = MeetsVertical(*cuts_[c], region) ? 1 : 0;
         } else {
           out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
         }
@@ -322,8 +328,7 @@ class TreeSearch {
       if (decided_[j] != kClutter) continue;
       for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
         if (!alive[c] || OverlapsAssigned(candidate_edge_[c], static_cast<int>(j))) continue;
-        if (Extend(candidate_edge_[c], static_cast<int>(j), region, &maximal_scratch_) &&
-            KeepsEveryCluster(region, maximal_scratch_)) {
+        if (Extend(c, region, &maximal_scratch_) && KeepsEveryCluster(region, maximal_scratch_)) {
           return false;
         }
       }
@@ -343,6 +348,7 @@ class TreeSearch {
   std::vector<int> order_;  // lines by decreasing cap
   // Candidates by line: line j holds [line_offsets_[j], line_offsets_[j + 1]).
   std::vector<int> line_offsets_, candidate_edge_, candidate_line_;
+  std::vector<std::optional<VerticalCut>> cuts_;  // vertical candidates' cuts
   // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
   std::vector<std::vector<char>> alive_;
   std::vector<int> decided_;     // per line: assigned candidate, kUndecided or kClutter

@@ -25,7 +25,9 @@ double EndpointAlongDensity(double t, double length, double sigma, double end_pr
 double MaxLogLikelihoodRatio(double length, const LineFitModel& model) {
   const double d = model.image_diagonal_px;
   const double piece = std::max(length, 1.0);
-  const double end_sigma = std::hypot(model.end_shortening * piece, model.offset_px);
+  const double end_sigma =
+      std::sqrt((model.end_shortening * piece) * (model.end_shortening * piece) +
+                model.offset_px * model.offset_px);
   return std::log(d / (2.0 * model.offset_px * model.angle_rad)) +
          2.0 * std::log(d * EndpointAlongDensity(0.0, piece, end_sigma, model.end_probability));
 }
@@ -68,7 +70,9 @@ LineFit FitLine(const Segment2& projected, const Segment2& observed,
   const double d2 = model.offset_px * model.offset_px;
   const double sigma_a = std::sqrt(d2 + end_variance.x()),
                sigma_b = std::sqrt(d2 + end_variance.y());
-  const double end_sigma = std::hypot(model.end_shortening * lambda, std::max(sigma_a, sigma_b));
+  const double end_sigma =
+      std::sqrt((model.end_shortening * lambda) * (model.end_shortening * lambda) +
+                (std::max(sigma_a, sigma_b)) * (std::max(sigma_a, sigma_b)));
   const double along =
       std::log(model.image_diagonal_px *
                EndpointAlongDensity(s_a, lambda, end_sigma, model.end_probability)) +

@@ -28,18 +28,28 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
   return r;
 }
 
+PoseView ViewOf(const Pose3Dof& pose, double height, double tilt) {
+  const Eigen::Matrix3d cam_from_level = LevelFromCam(tilt).transpose();
+  const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
+  Eigen::Matrix3d level_from_world, d_level_from_world;
+  level_from_world << sh, -ch, 0.0, 0.0, 0.0, -1.0, ch, sh, 0.0;
+  d_level_from_world << ch, sh, 0.0, 0.0, 0.0, 0.0, -sh, ch, 0.0;
+  return {cam_from_level * level_from_world, cam_from_level * d_level_from_world,
+          Eigen::Vector3d(pose.x, pose.y, height)};
+}
+
 Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                   const CameraIntrinsics& camera, double height, double tilt,
                                   const Pose3Dof& pose, double scale,
                                   Eigen::Matrix<double, 3, 4>* derivative) {
-  const Eigen::Matrix3d cam_from_level = LevelFromCam(tilt).transpose();
-  const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
-  Eigen::Matrix3d level_from_world;
-  level_from_world << sh, -ch, 0.0, 0.0, 0.0, -1.0, ch, sh, 0.0;
-  const Eigen::Matrix3d rotation = cam_from_level * level_from_world;
-  const Eigen::Vector3d centre(pose.x, pose.y, height);
-  const Eigen::Vector3d xa = rotation * (a - centre);
-  const Eigen::Vector3d xb = rotation * (b - centre);
+  return ProjectedEdgeLine(a, b, camera, ViewOf(pose, height, tilt), scale, derivative);
+}
+
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, const PoseView& view,
+                                  double scale, Eigen::Matrix<double, 3, 4>* derivative) {
+  const Eigen::Vector3d xa = view.rotation * (a - view.centre);
+  const Eigen::Vector3d xb = view.rotation * (b - view.centre);
   // Line through the two projections in normalised coordinates, then in pixels: l_p = K^-T l_n,
   // K with focal lengths s px, s py; then scaled to a unit normal.
   const Eigen::Vector3d ln = xa.cross(xb);
@@ -49,20 +59,18 @@ Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3
                            l.z() - l.x() * camera.u0 / fx - l.y() * camera.v0 / fy);
   };
   const Eigen::Vector3d lp = to_pixels(ln);
-  const double norm = std::hypot(lp.x(), lp.y());
+  const double norm = std::sqrt(lp.x() * lp.x() + lp.y() * lp.y());
   const Eigen::Vector3d line = lp / norm;
   if (derivative) {
     // d (lp / |lp_uv|) = (dlp - line (line_uv . dlp_uv)) / |lp_uv|.
     auto column = [&](const Eigen::Vector3d& dlp, int k) {
       derivative->col(k) = (dlp - line * (line.x() * dlp.x() + line.y() * dlp.y())) / norm;
     };
-    Eigen::Matrix3d d_level_from_world;
-    d_level_from_world << ch, sh, 0.0, 0.0, 0.0, 0.0, -sh, ch, 0.0;
-    const Eigen::Matrix3d d_rotation = cam_from_level * d_level_from_world;
-    column(to_pixels((d_rotation * (a - centre)).cross(xb) + xa.cross(d_rotation * (b - centre))),
+    column(to_pixels((view.d_rotation * (a - view.centre)).cross(xb) +
+                     xa.cross(view.d_rotation * (b - view.centre))),
            0);
     for (int k = 1; k <= 2; ++k) {  // d x_a / dx = d x_b / dx = -rotation.col(0); y likewise
-      const Eigen::Vector3d d = -rotation.col(k - 1);
+      const Eigen::Vector3d d = -view.rotation.col(k - 1);
       column(to_pixels(d.cross(xb) + xa.cross(d)), k);
     }
     // lp(s) = (p / s, q / s, l_z - (p u0 + q v0) / s): d lp / ds = -(lp - (0, 0, l_z)) / s.
@@ -74,9 +82,15 @@ Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
                                   double height, double tilt, const Pose3Dof& pose, double scale,
                                   Eigen::Matrix<double, 2, 4>* jacobian) {
+  return EndpointResiduals(match, camera, ViewOf(pose, height, tilt), scale, jacobian);
+}
+
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  const PoseView& view, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian) {
   Eigen::Matrix<double, 3, 4> d;
-  const Eigen::Vector3d line = ProjectedEdgeLine(match.edge_a, match.edge_b, camera, height, tilt,
-                                                 pose, scale, jacobian ? &d : nullptr);
+  const Eigen::Vector3d line =
+      ProjectedEdgeLine(match.edge_a, match.edge_b, camera, view, scale, jacobian ? &d : nullptr);
   const Eigen::Vector3d qa(match.observed.a.x(), match.observed.a.y(), 1.0);
   const Eigen::Vector3d qb(match.observed.b.x(), match.observed.b.y(), 1.0);
   if (jacobian) {
@@ -118,9 +132,9 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
   };
   auto cost_at = [&](const Pose3Dof& pose, double scale) {
     double cost = 0.0;
+    const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
-      const Eigen::Vector2d r =
-          m.whitening * EndpointResiduals(m, camera, height, tilt, pose, scale, nullptr);
+      const Eigen::Vector2d r = m.whitening * EndpointResiduals(m, camera, view, scale, nullptr);
       cost += huber(r[0]) + huber(r[1]);
     }
     const double p = prior_weight * (scale - 1.0);
@@ -134,9 +148,10 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     jtr->setZero();
     double squares = 0.0;
     *chi2 = 0.0;
+    const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
       Eigen::Matrix<double, 2, 4> j;
-      const Eigen::Vector2d raw = EndpointResiduals(m, camera, height, tilt, pose, scale, &j);
+      const Eigen::Vector2d raw = EndpointResiduals(m, camera, view, scale, &j);
       squares += raw.squaredNorm();
       const Eigen::Vector2d r = m.whitening * raw;
       *chi2 += r.squaredNorm();

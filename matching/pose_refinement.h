@@ -54,6 +54,15 @@ struct PoseRefinementResult {
   double heading_sigma_rad = 0.0;
 };
 
+// The camera-from-world rotation of a robot pose, its derivative w.r.t. the heading and the
+// camera centre: computed once for many projections at one pose.
+struct PoseView {
+  Eigen::Matrix3d rotation;
+  Eigen::Matrix3d d_rotation;
+  Eigen::Vector3d centre;
+};
+PoseView ViewOf(const Pose3Dof& pose, double height, double tilt);
+
 // The image line of the model edge through a and b (world) seen from `pose` with the focal
 // lengths scaled by `scale`: (l_u, l_v, l_c) with l_u u + l_v v + l_c = 0 and l_u^2 + l_v^2 = 1
 // (pixels; the line through the projections of a and b). `derivative` (optional) gets
@@ -62,6 +71,9 @@ Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3
                                   const CameraIntrinsics& camera, double height, double tilt,
                                   const Pose3Dof& pose, double scale,
                                   Eigen::Matrix<double, 3, 4>* derivative);
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, const PoseView& view,
+                                  double scale, Eigen::Matrix<double, 3, 4>* derivative);
 
 // The two endpoint residuals (pixels, signed) of `match` at `pose`; `jacobian` (optional) gets
 // d residual / d (heading, x, y).
@@ -73,6 +85,9 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
 // d residual / d (heading, x, y, scale).
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
                                   double height, double tilt, const Pose3Dof& pose, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian);
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  const PoseView& view, double scale,
                                   Eigen::Matrix<double, 2, 4>* jacobian);
 
 // Refines `start` by Levenberg-Marquardt on all whitened endpoint residuals (Huber-weighted),

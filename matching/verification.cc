@@ -67,31 +67,23 @@ struct EdgeImage {
   }
 };
 
-// Pixel of world point `p` seen from `pose` with focal lengths scaled by `scale`.
-Eigen::Vector2d ProjectPoint(const VerificationContext& context, const Pose3Dof& pose, double scale,
-                             const Eigen::Vector3d& p) {
-  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
-  return ScaledCamera(*context.camera, scale).Project(cam_from_world * p);
-}
-
-// d pixel(p) / d (heading, x, y, scale) by central differences.
-Eigen::Matrix<double, 2, 4> ProjectionJacobian(const VerificationContext& context,
-                                               const Pose3Dof& pose, double scale,
-                                               const Eigen::Vector3d& p) {
-  constexpr double kStep = 1e-6;
+// d pixel(p) / d (heading, x, y, scale) for the world point p: with X = R (p - C) and
+// u = u0 + s px X_x / X_z, v = v0 + s py X_y / X_z.
+Eigen::Matrix<double, 2, 4> ProjectionJacobian(const CameraIntrinsics& camera, const PoseView& view,
+                                               double scale, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d x = view.rotation * (p - view.centre);
+  Eigen::Matrix<double, 3, 3> dx;  // columns: d X / d heading, x, y
+  dx.col(0) = view.d_rotation * (p - view.centre);
+  dx.col(1) = -view.rotation.col(0);
+  dx.col(2) = -view.rotation.col(1);
+  const double fx = scale * camera.px, fy = scale * camera.py, z2 = x.z() * x.z();
   Eigen::Matrix<double, 2, 4> j;
-  for (int k = 0; k < 4; ++k) {
-    Pose3Dof plus = pose, minus = pose;
-    double s_plus = scale, s_minus = scale;
-    double* fields[4][2] = {{&plus.heading, &minus.heading},
-                            {&plus.x, &minus.x},
-                            {&plus.y, &minus.y},
-                            {&s_plus, &s_minus}};
-    *fields[k][0] += kStep;
-    *fields[k][1] -= kStep;
-    j.col(k) = (ProjectPoint(context, plus, s_plus, p) - ProjectPoint(context, minus, s_minus, p)) /
-               (2.0 * kStep);
+  for (int k = 0; k < 3; ++k) {
+    j(0, k) = fx * (dx(0, k) * x.z() - x.x() * dx(2, k)) / z2;
+    j(1, k) = fy * (dx(1, k) * x.z() - x.y() * dx(2, k)) / z2;
   }
+  j(0, 3) = camera.px * x.x() / x.z();
+  j(1, 3) = camera.py * x.y() / x.z();
   return j;
 }
 
@@ -99,6 +91,7 @@ std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Po
                                     double focal_scale) {
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  const PoseView view = ViewOf(pose, context.height, context.tilt);
   std::vector<EdgeImage> out(context.edges->size());
   for (size_t e = 0; e < out.size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
@@ -109,10 +102,10 @@ std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Po
                    camera.Project(cam_from_world * image.world.b)};
     if (image.image.Length() < 1e-6) continue;
     image.visible = true;
-    image.line = ProjectedEdgeLine(edge.a, edge.b, *context.camera, context.height, context.tilt,
-                                   pose, focal_scale, &image.d_line);
-    image.d_start = ProjectionJacobian(context, pose, focal_scale, image.world.a);
-    image.d_end = ProjectionJacobian(context, pose, focal_scale, image.world.b);
+    image.line =
+        ProjectedEdgeLine(edge.a, edge.b, *context.camera, view, focal_scale, &image.d_line);
+    image.d_start = ProjectionJacobian(*context.camera, view, focal_scale, image.world.a);
+    image.d_end = ProjectionJacobian(*context.camera, view, focal_scale, image.world.b);
   }
   return out;
 }
@@ -387,11 +380,11 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
                         (*context.edges)[e2], context.height)) {
         inliers.clear();
         double chi2 = 0.0;
+        const PoseView view = ViewOf(candidate, context.height, context.tilt);
         for (size_t k = 0; k < matches.size(); ++k) {
-          const double c =
-              (matches[k].whitening * EndpointResiduals(matches[k], *context.camera, context.height,
-                                                        context.tilt, candidate, 1.0, nullptr))
-                  .squaredNorm();
+          const double c = (matches[k].whitening *
+                            EndpointResiduals(matches[k], *context.camera, view, 1.0, nullptr))
+                               .squaredNorm();
           if (c > options.consensus_chi2) continue;
           inliers.push_back(pairs[k]);
           chi2 += c;
@@ -499,11 +492,11 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
         Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta)));
   }
   std::vector<std::pair<int, int>> fitting;
+  const PoseView view = ViewOf(verified.pose, context.height, context.tilt);
   for (size_t e = 0; e < context.edges->size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
-    const Eigen::Vector3d image_line =
-        ProjectedEdgeLine(edge.a, edge.b, *context.camera, context.height, context.tilt,
-                          verified.pose, verified.refinement.focal_scale, nullptr);
+    const Eigen::Vector3d image_line = ProjectedEdgeLine(edge.a, edge.b, *context.camera, view,
+                                                         verified.refinement.focal_scale, nullptr);
     for (size_t l = 0; l < context.lines->size(); ++l) {
       const Segment2& s = (*context.lines)[l].pixels;
       const Eigen::Vector2d r(image_line.dot(Eigen::Vector3d(s.a.x(), s.a.y(), 1.0)),
