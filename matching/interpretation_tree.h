@@ -32,7 +32,7 @@ struct InterpretationTreeOptions {
   double fragment_offset_px = 1.0;
   // Iterative deepening: each pass lowers the bound by this many lines' worth of caps.
   double deepening_lines = 2.0;
-  int max_nodes = 20000;     // search budget (deterministic), over all passes
+  int max_nodes = 5000;      // search budget (deterministic), over all passes
   int max_hypotheses = 200;  // leaves handed to the visitor at most
 
   bool Check(std::string* why) const;
