@@ -15,10 +15,10 @@ Eigen::Matrix2d EndpointNoiseCovariance(double t_a, double t_b, double sigma_d,
   return c;
 }
 
-double EndpointAlongDensity(double t, double length, double sigma, double end_probability) {
-  const double d = t < 0.0 || t > length ? std::max(-t, t - length) : std::min(t, length - t);
+double EndpointAlongDensity(double inward, double length, double sigma, double end_probability) {
   constexpr double kHalfNormal = 0.7978845608028654;  // sqrt(2 / pi)
-  return end_probability * kHalfNormal / sigma * std::exp(-0.5 * d * d / (sigma * sigma)) +
+  return end_probability * kHalfNormal / sigma *
+             std::exp(-0.5 * inward * inward / (sigma * sigma)) +
          (1.0 - end_probability) / length;
 }
 
@@ -73,11 +73,13 @@ LineFit FitLine(const Segment2& projected, const Segment2& observed,
   const double end_sigma =
       std::sqrt((model.end_shortening * lambda) * (model.end_shortening * lambda) +
                 (std::max(sigma_a, sigma_b)) * (std::max(sigma_a, sigma_b)));
+  // The observed segment's start (lo) belongs to the projection's start, its end (hi) to its
+  // end; the pose uncertainty of the end concerned.
   const double along =
       std::log(model.image_diagonal_px *
-               EndpointAlongDensity(s_a, lambda, end_sigma, model.end_probability)) +
+               EndpointAlongDensity(fit.lo, lambda, end_sigma, model.end_probability)) +
       std::log(model.image_diagonal_px *
-               EndpointAlongDensity(s_b, lambda, end_sigma, model.end_probability));
+               EndpointAlongDensity(lambda - fit.hi, lambda, end_sigma, model.end_probability));
   fit.log_likelihood_ratio =
       std::log(model.image_diagonal_px * length / (2.0 * std::sqrt(det))) - 0.5 * fit.chi2 + along;
   fit.gated = fit.chi2 <= model.gate_chi2 && -fit.lo <= model.extent_sigmas * sigma_a &&

@@ -22,9 +22,10 @@ struct LineFitModel {
   // endpoint's position.
   double gate_chi2 = 13.8;
   double extent_sigmas = 3.0;
-  // Along the edge, an observed endpoint lies near an end of the projected piece with
-  // probability end_probability (shortened by a half-normal amount of standard deviation
-  // end_shortening x the piece's length), else anywhere on it (a cut: occlusion, fragmentation).
+  // Along the edge, the start (end) of an observed segment lies near the start (end) of the
+  // projected piece with probability end_probability (shortened by a half-normal amount of
+  // standard deviation end_shortening x the piece's length), else anywhere on it (a cut:
+  // occlusion, fragmentation).
   double end_probability = 0.8;
   double end_shortening = 0.1;
 };
@@ -41,7 +42,8 @@ struct LineFit {
   double overhang_px = 0.0;
   // ln p(segment | edge) - ln p(segment | clutter) (nats): across the line
   // ln(D L / (2 sqrt(det covariance))) - chi2 / 2 (L the observed length), plus along it
-  // sum_k ln(D p(t_k)) for the endpoints' positions t_k (clutter endpoints uniform over D).
+  // sum_k ln(D p(t_k)) for the endpoints' distances t_k in from their ends of the projection
+  // (clutter endpoints uniform over D).
   double log_likelihood_ratio = -std::numeric_limits<double>::infinity();
   bool gated = false;  // chi2 and overhang within the model's gates
 };
@@ -50,9 +52,10 @@ struct LineFit {
 // rotation centre): sigma_d^2 [1 1; 1 1] + sigma_theta^2 [t_a^2 t_a t_b; t_a t_b t_b^2].
 Eigen::Matrix2d EndpointNoiseCovariance(double t_a, double t_b, double sigma_d, double sigma_theta);
 
-// Density (1 / pixels) of an observed endpoint at `t` along a projected piece [0, length]:
-// w HalfNormal(distance to the nearer end; sigma) + (1 - w) / length.
-double EndpointAlongDensity(double t, double length, double sigma, double end_probability);
+// Density (1 / pixels) of an observed endpoint `inward` pixels in from its end of a projected
+// piece of `length` pixels (negative: beyond it): end_probability HalfNormal(|inward|; sigma)
+// (the end, shortened) + (1 - end_probability) / length (a cut anywhere along the piece).
+double EndpointAlongDensity(double inward, double length, double sigma, double end_probability);
 
 // The largest log-likelihood ratio (nats) a segment of `length` pixels can reach under `model`:
 // chi2 = 0, no pose uncertainty, both endpoints at the ends of a piece of about its length.
