@@ -52,6 +52,17 @@ bool RegionHolds(const FeasibleRegion& region, const Pose3Dof& truth) {
 
 }  // namespace
 
+LocalizationProblem ProblemOf(const SyntheticScene& scene) {
+  LocalizationProblem p;
+  p.lines = scene.lines;
+  p.prior = scene.prior;
+  p.delta_t = scene.delta_t;
+  p.delta_phi = scene.delta_phi;
+  p.height = scene.height;
+  p.tilt = scene.tilt;
+  return p;
+}
+
 TruthDiagnosis DiagnoseTruth(const Localizer& localizer, const LocalizationProblem& problem,
                              const Pose3Dof& truth,
                              const std::vector<std::pair<int, int>>& truth_matches) {

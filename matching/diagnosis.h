@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "matching/localizer.h"
+#include "models/synthetic_scenes.h"
 
 namespace linetrack {
 
@@ -51,6 +52,9 @@ struct TruthDiagnosis {
   double position_sigma_m = 0.0;
   double heading_sigma_deg = 0.0;
 };
+
+// The localisation problem of a synthetic scene (its lines, prior, height and tilt).
+LocalizationProblem ProblemOf(const SyntheticScene& scene);
 
 // Runs the checks for `problem` whose truth is `truth` with correspondences `truth_matches`
 // (model edge id, line index).

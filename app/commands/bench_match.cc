@@ -234,13 +234,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     std::map<std::string, int> categories;
     for (size_t i = 0; i < scenes.size(); ++i) {
       const SyntheticScene& scene = scenes[i];
-      LocalizationProblem problem;
-      problem.lines = scene.lines;
-      problem.prior = scene.prior;
-      problem.delta_t = scene.delta_t;
-      problem.delta_phi = scene.delta_phi;
-      problem.height = scene.height;
-      problem.tilt = scene.tilt;
+      const LocalizationProblem problem = ProblemOf(scene);
       for (int m = 0; m < (opt.baseline ? 2 : 1); ++m) {
         const auto start = std::chrono::steady_clock::now();
         const LocalizationResult result = (m == 0 ? tree : baseline).Localize(problem);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/localize_io.h"
+#include "cli_fixture.h"
 #include "models/camera.h"
 #include "models/robot_pose.h"
 
@@ -27,18 +28,6 @@ constexpr double kBoundSlack = 1e-9;
 const std::string kSource = LINETRACK_SOURCE_DIR;
 const std::string kModel = kSource + "/models/hall.cao";
 
-struct CommandRun {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   std::vector<nlohmann::json> rows;
   std::ifstream in(path);
@@ -48,31 +37,9 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   return rows;
 }
 
-class SynthCli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::path(LINETRACK_BINARY_DIR) / "test_output" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-
-  // Runs `linetrack ARGS`, capturing stdout and stderr.
-  CommandRun Linetrack(const std::string& args) {
-    const std::string out = (dir_ / "stdout.txt").string(), err = (dir_ / "stderr.txt").string();
-    const std::string cmd = std::string(LINETRACK_EXE) + " " + args + " > " + out + " 2> " + err;
-    const int status = std::system(cmd.c_str());
-    CommandRun run;
-    run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = ReadAll(out);
-    run.err = ReadAll(err);
-    fs::remove(out);
-    fs::remove(err);
-    return run;
-  }
-
-  fs::path dir_;
-};
+using SynthCli = testing::CliTest;
+using testing::CommandRun;
+using testing::ReadAll;
 
 TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
   const fs::path out = dir_ / "qi2";
