@@ -56,7 +56,8 @@ class TreeSearch {
     regions_.resize(n + 2);
     alive_.assign(n + 2, std::vector<char>(candidate_edge_.size(), 1));
     // Iterative deepening on the bound: from what all lines with a candidate could give, down
-    // by deepening_lines mean caps per pass, until the visitor's own bound is reached.
+    // by deepening_lines mean caps or deepening_fraction of the bound per pass (the larger),
+    // until the visitor's own bound is reached.
     double top = 0.0;
     int with_candidates = 0;
     for (size_t j = 0; j < n; ++j) {
@@ -66,7 +67,8 @@ class TreeSearch {
     }
     if (with_candidates == 0) return;
     const double step = options_.deepening_lines * top / with_candidates;
-    for (double pass = top - step;; pass -= step) {
+    for (double pass = top - std::max(step, options_.deepening_fraction * top);;
+         pass -= std::max(step, options_.deepening_fraction * pass)) {
       pass_bound_ = std::max(pass, 0.0);
       ++stats_->passes;
       Search(0, root);
@@ -87,9 +89,14 @@ class TreeSearch {
     std::iota(order_.begin(), order_.end(), 0);
     std::stable_sort(order_.begin(), order_.end(),
                      [&](int a, int b) { return caps_[a] > caps_[b]; });
+    // Only the max_lines lines with the largest caps enter the tree (the budget: many clutter
+    // lines); guided matching still sees all of them.
+    std::vector<bool> in_tree(lines_.size(), false);
+    for (size_t k = 0; k < order_.size() && static_cast<int>(k) < options_.max_lines; ++k)
+      in_tree[order_[k]] = true;
     line_offsets_.assign(1, 0);
     for (size_t j = 0; j < lines_.size(); ++j) {
-      for (size_t e = 0; e < edges_.size(); ++e) {
+      for (size_t e = 0; e < edges_.size() && in_tree[j]; ++e) {
         bool pass = false;
         if (edges_[e].vertical) {
           pass = lines_[j].maybe_vertical &&
@@ -160,7 +167,8 @@ class TreeSearch {
   // with a candidate still alive; lines without one are clutter for free (their cap is no longer
   // in the bound).
   void Search(size_t depth, const FeasibleRegion& region) {
-    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
+    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses ||
+        stats_->checks >= options_.max_checks) {
       stats_->budget_exhausted = true;
       return;
     }
@@ -225,6 +233,7 @@ class TreeSearch {
       for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
         out[c] = 0;
         if (assigned || !in[c]) continue;
+        ++stats_->checks;
         const MatchEdge& e = edges_[candidate_edge_[c]];
         const ObservedLine& l = lines_[j];
         if (e.vertical) {
@@ -372,10 +381,11 @@ class TreeSearch {
 bool InterpretationTreeOptions::Check(std::string* why) const {
   if (!(gate_sigmas > 0.0) || min_matches < 2 || max_nodes < 1 || max_hypotheses < 1 ||
       !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1 ||
-      !(deepening_lines > 0.0)) {
+      !(deepening_lines > 0.0) || !(deepening_fraction >= 0.0 && deepening_fraction < 1.0) ||
+      max_lines < 2 || max_checks < 1) {
     *why =
         "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1, "
-        "deepening_lines > 0";
+        "deepening_lines > 0, deepening_fraction in [0, 1), max_lines >= 2";
     return false;
   }
   return true;

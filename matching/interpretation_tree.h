@@ -30,10 +30,14 @@ struct InterpretationTreeOptions {
   // Lines assigned to one edge are fragments: they may not overlap (beyond extent_slack_px) and
   // must lie on one line (FragmentChiSquare with this offset noise, pixels, below 13.8).
   double fragment_offset_px = 1.0;
-  // Iterative deepening: each pass lowers the bound by this many lines' worth of caps.
+  // Iterative deepening: each pass lowers the bound by this many lines' worth of caps, or by
+  // this fraction of it when that is more (many lines).
   double deepening_lines = 2.0;
+  double deepening_fraction = 0.4;
+  int max_lines = 100;       // lines entering the tree at most: those with the largest caps
   int max_nodes = 5000;      // search budget (deterministic), over all passes
   int max_hypotheses = 200;  // leaves handed to the visitor at most
+  int max_checks = 100000;   // forward-checking tests at most (the work of the nodes)
 
   bool Check(std::string* why) const;
 };
@@ -75,6 +79,7 @@ struct VerifiedBasin {
 struct InterpretationTreeStats {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int nodes = 0;             // tree nodes expanded
+  int checks = 0;            // forward-checking tests of candidates against regions
   int leaves = 0;            // leaves handed to the visitor
   int passes = 0;            // iterative-deepening passes
   bool budget_exhausted = false;

@@ -66,6 +66,7 @@ LineFit FitLine(const Segment2& projected, const Segment2& observed,
   const double det = fit.covariance.determinant();
   if (!(det > 0.0)) return fit;
   fit.chi2 = fit.residuals.dot(fit.covariance.inverse() * fit.residuals);
+  if (fit.chi2 > model.gate_chi2) return fit;  // outside the gate: no ratio needed
   // Position noise of the projection's ends along it: the line noise (sigma_d) and the pose.
   const double d2 = model.offset_px * model.offset_px;
   const double sigma_a = std::sqrt(d2 + end_variance.x()),

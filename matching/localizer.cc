@@ -165,6 +165,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
         &stats, &basins);
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
+    result.tree_checks = stats.checks;
     result.budget_exhausted = stats.budget_exhausted;
   } else {
     BaselineStats stats;
@@ -221,8 +222,10 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     result.reason = "ambiguous: another pose explains the image almost as well";
     return;
   }
-  if (score < vo.min_evidence_nats) {
-    result.reason = "weak evidence (" + std::to_string(score) + " nats)";
+  const double required = RequiredEvidence(context, vo, best);
+  if (score < required) {
+    result.reason =
+        "weak evidence (" + std::to_string(score) + " of " + std::to_string(required) + " nats)";
     return;
   }
   std::set<int> confident_edges;

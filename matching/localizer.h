@@ -68,8 +68,9 @@ struct LocalizationResult {
   int candidate_edges = 0;   // edges kept by the view-invariant regions
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int tree_nodes = 0;
-  int hypotheses = 0;  // hypotheses verified (pose evaluations)
-  int samples = 0;     // baseline only: random pairs drawn
+  int tree_checks = 0;  // forward-checking tests of the tree search
+  int hypotheses = 0;   // hypotheses verified (pose evaluations)
+  int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
   std::string reason;               // why no pose was accepted (empty when found)
   std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first

@@ -323,12 +323,9 @@ LineFitModel FitModel(const VerificationContext& context, const VerificationOpti
 
 bool VerificationOptions::Check(std::string* why) const {
   if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
-      !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
-      !(detection_probability > 0.0 && detection_probability < 1.0) ||
-      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
-    *why =
-        "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1), "
-        "detection probability in (0, 1)";
+      !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) || !(visibility_step_px > 0.0) ||
+      !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
+    *why = "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1)";
     return false;
   }
   return refinement.Check(why);
@@ -569,8 +566,8 @@ void CompleteEvidence(const VerificationContext& context, const VerificationOpti
   const Eigen::Vector3d eye(verified->pose.x, verified->pose.y, context.height);
   const CameraIntrinsics camera = ScaledCamera(*context.camera, verified->refinement.focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(verified->pose, context));
-  const double log_detected = std::log(options.detection_probability);
-  const double log_missed = std::log(1.0 - options.detection_probability);
+  const double log_detected = std::log(context.noise.detection_probability);
+  const double log_missed = std::log(1.0 - context.noise.detection_probability);
   PoseEvidence& evidence = verified->evidence;
   evidence.edges_nats = evidence.predicted_px = evidence.covered_px = 0.0;
   for (size_t e = 0; e < images.size(); ++e) {
@@ -607,6 +604,18 @@ void CompleteEvidence(const VerificationContext& context, const VerificationOpti
     evidence.edges_nats += fraction * log_detected + (1.0 - fraction) * log_missed;
   }
   verified->evidence_complete = true;
+}
+
+double RequiredEvidence(const VerificationContext& context, const VerificationOptions& options,
+                        const VerifiedPose& verified) {
+  if (context.prior == nullptr) return options.chance_nats;
+  const PriorRegion& prior = *context.prior;
+  const double prior_volume = kPi * std::max(prior.radius, 0.01) * std::max(prior.radius, 0.01) *
+                              std::max(prior.heading.Width(), DegToRad(0.1));
+  const double det = verified.refinement.covariance.topLeftCorner<3, 3>().determinant();
+  if (!(det > 0.0) || !std::isfinite(det)) return std::numeric_limits<double>::infinity();
+  const double pose_volume = std::pow(2.0 * kPi, 1.5) * std::sqrt(det);
+  return options.chance_nats + std::max(0.0, std::log(prior_volume / pose_volume));
 }
 
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
