@@ -17,7 +17,7 @@ namespace {
 
 constexpr int kScenes = 50;
 // Generous against the benchmark (about 97 % correct at QI2 on 430 scenes): 45 of 50 correct
-// (measured 48), no wrong pose.
+// (measured 50), no wrong pose.
 constexpr int kMinCorrect = 45;
 constexpr double kWrongPositionM = 0.5;  // the benchmark's "accurate" bounds
 constexpr double kWrongHeadingDeg = 5.0;
