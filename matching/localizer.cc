@@ -116,6 +116,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     double best = -std::numeric_limits<double>::infinity();
     std::vector<std::vector<std::pair<int, int>>> verified_pairs;
     std::vector<VerifiedBasin> basins;
+    long pair_tests = 0;
+    context.pair_tests = &pair_tests;
     SearchInterpretationTree(
         edges, lines, prior, options_.tree, caps,
         [&](const Hypothesis& h) {
@@ -138,6 +140,10 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
             if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
               return bound;
             }
+          }
+          if (pair_tests >= vo.max_pair_tests) {
+            result.budget_exhausted = true;
+            return std::numeric_limits<double>::infinity();  // stops the search
           }
           ++result.hypotheses;
           VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
@@ -166,7 +172,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
     result.tree_checks = stats.checks;
-    result.budget_exhausted = stats.budget_exhausted;
+    result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
+    context.pair_tests = nullptr;
   } else {
     BaselineStats stats;
     verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);

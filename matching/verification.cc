@@ -165,18 +165,46 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   const Eigen::Vector3d eye(pose.x, pose.y, context.height);
   std::vector<Candidate> out;
+  if (context.pair_tests != nullptr) {
+    const long visible = std::count_if(images.begin(), images.end(),
+                                       [](const EdgeImage& image) { return image.visible; });
+    *context.pair_tests += visible * static_cast<long>(context.lines->size());
+  }
+  // Per edge: the ends' variances along the projection, and a distance beyond which no line
+  // can be within the gate: chi2 >= max(r_a^2, r_b^2) / trace(covariance), with the trace at most
+  // 2 sigma_d^2 + 2 (sigma_theta D)^2 + twice the pose term at the projection's ends.
+  std::vector<Eigen::Vector2d> end_variance(images.size());
+  std::vector<double> reject_px(images.size(), 0.0);
+  const double d = model.image_diagonal_px;
+  for (size_t e = 0; e < images.size(); ++e) {
+    const EdgeImage& image = images[e];
+    if (!image.visible) continue;
+    end_variance[e] = image.EndVariance(pose_covariance);
+    double pose_variance = 0.0;
+    for (const Eigen::Vector2d& end : {image.image.a, image.image.b}) {
+      const Eigen::Matrix<double, 1, 4> j =
+          Eigen::Vector3d(end.x(), end.y(), 1.0).transpose() * image.d_line;
+      pose_variance = std::max(pose_variance, (j * pose_covariance * j.transpose())(0, 0));
+    }
+    const double trace = 2.0 * model.offset_px * model.offset_px +
+                         2.0 * (model.angle_rad * d) * (model.angle_rad * d) + 4.0 * pose_variance;
+    reject_px[e] = std::sqrt(model.gate_chi2 * trace);
+  }
   for (size_t l = 0; l < context.lines->size(); ++l) {
     const Segment2& observed = (*context.lines)[l].pixels;
     const Eigen::Vector3d qa(observed.a.x(), observed.a.y(), 1.0);
     const Eigen::Vector3d qb(observed.b.x(), observed.b.y(), 1.0);
     for (size_t e = 0; e < images.size(); ++e) {
       const EdgeImage& image = images[e];
-      if (!image.visible) continue;
+      if (!image.visible ||
+          std::max(std::abs(image.line.dot(qa)), std::abs(image.line.dot(qb))) > reject_px[e]) {
+        continue;
+      }
       Eigen::Matrix<double, 2, 4> j;
       j.row(0) = qa.transpose() * image.d_line;
       j.row(1) = qb.transpose() * image.d_line;
       LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model,
-                            image.EndVariance(pose_covariance));
+                            end_variance[e]);
       fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
       if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
       if (context.occlusion != nullptr &&
@@ -323,8 +351,8 @@ LineFitModel FitModel(const VerificationContext& context, const VerificationOpti
 
 bool VerificationOptions::Check(std::string* why) const {
   if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
-      !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) || !(visibility_step_px > 0.0) ||
-      !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
+      max_pair_tests < 1 || !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
+      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
     *why = "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1)";
     return false;
   }

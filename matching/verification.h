@@ -57,6 +57,9 @@ struct VerificationOptions {
   // 0.912 of their caps (median 0.688) on 300 synthetic scenes of seed 7, independent of the
   // benchmark's seed 1 (docs/matching.md).
   double cap_efficiency = 0.95;
+  // Work budget of the verification (deterministic): (line, visible edge) pairs guided matching
+  // may test over all hypotheses of one localisation; then no more hypotheses are verified.
+  long max_pair_tests = 1500000;
   // Observability: an accepted pose's standard deviations (noise model) must be below these.
   double max_position_sigma_m = 0.5;
   double max_heading_sigma_deg = 5.0;
@@ -85,6 +88,8 @@ struct VerificationContext {
   const PriorRegion* prior = nullptr;
   const NavigableArea* area = nullptr;
   LineNoise noise;  // line noise and calibration error (focal_relative)
+  // When set, counts the (line, visible edge) pairs guided matching tests (the work budget).
+  long* pair_tests = nullptr;
 };
 
 // Evidence for a pose (nats): the log-likelihood ratio of the observed lines under "the camera is
