@@ -59,7 +59,7 @@ struct VerificationOptions {
   double cap_efficiency = 0.95;
   // Work budget of the verification (deterministic): (line, visible edge) pairs guided matching
   // may test over all hypotheses of one localisation; then no more hypotheses are verified.
-  long max_pair_tests = 1500000;
+  long max_pair_tests = 800000;
   // Observability: an accepted pose's standard deviations (noise model) must be below these.
   double max_position_sigma_m = 0.5;
   double max_heading_sigma_deg = 5.0;
