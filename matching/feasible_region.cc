@@ -99,9 +99,30 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
 
 void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
                              const Eigen::Vector2d& n2, double d2) {
-  ConvexPolygon half;
-  half.ClipFrom(source, n1, d1);
-  ClipFrom(half, n2, d2);
+  // Most cuts keep a polygon whole or drop it: decide those from the vertices' sides first.
+  bool all1 = true, all2 = true, any1 = false, any2 = false;
+  for (int i = 0; i < source.count_; ++i) {
+    const bool in1 = n1.dot(source.vertices_[i]) + d1 >= 0.0;
+    const bool in2 = n2.dot(source.vertices_[i]) + d2 >= 0.0;
+    all1 = all1 && in1;
+    all2 = all2 && in2;
+    any1 = any1 || in1;
+    any2 = any2 || in2;
+  }
+  if (!any1 || !any2) {
+    count_ = 0;
+  } else if (all1 && all2) {
+    std::copy(source.begin(), source.end(), vertices_.begin());
+    count_ = source.count_;
+  } else if (all1) {
+    ClipFrom(source, n2, d2);
+  } else if (all2) {
+    ClipFrom(source, n1, d1);
+  } else {
+    ConvexPolygon half;
+    half.ClipFrom(source, n1, d1);
+    ClipFrom(half, n2, d2);
+  }
 }
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {
