@@ -2,13 +2,16 @@
 // et al. 2005, section 3.2). Non-vertical edges are paired with all image lines under the unary
 // constraint, vertical edges with the vertical-candidate lines under the unary wedge and the
 // binary inscribed-angle constraints; along each branch the correspondences must share a common
-// pose (FeasibleRegion). Leaves are maximal consistent assignments of at least k edges.
+// pose (FeasibleRegion). The tree is searched line by line: each line takes a candidate edge or
+// none (clutter), an edge may take several collinear non-overlapping lines (fragments). Leaves
+// are maximal consistent assignments of at least k edges.
 //
 // The search is a branch and bound on the evidence a leaf could reach: every line has a cap (the
 // largest log-likelihood ratio it can contribute), a node's bound is the caps of its assigned
-// lines plus those of the unused lines some remaining or assigned edge could still take, and
-// nodes below the visitor's current bound are cut. Passes with a decreasing bound (iterative
+// lines plus those of the undecided lines with a candidate still consistent (forward checking),
+// and nodes below the visitor's current bound are cut. Passes with a decreasing bound (iterative
 // deepening) find the leaves that explain the most lines first, so the bound is tight early.
+// docs/matching.md has the details.
 #pragma once
 
 #include <functional>
@@ -59,8 +62,8 @@ struct PriorRegion {
 struct Hypothesis {
   std::vector<std::pair<int, int>> pairs;
   FeasibleRegion region;
-  // Sum of the caps of the leaf's lines and of the unused lines one of its edges could also take
-  // within its region (fragments): the most evidence its pose could gather from the tree's view.
+  // Sum of the caps of the leaf's lines: the most evidence its pose could gather from the
+  // tree's view (maximal: no other line fits its region).
   double bound = 0.0;
 };
 
