@@ -17,6 +17,7 @@
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "app/replay_output.h"
+#include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/occlusion.h"
 #include "tracking/capture/video_source.h"
@@ -212,8 +213,10 @@ int RunReplay(const ReplayOptions& opt) {
   std::unique_ptr<Localizer> localizer;
   std::unique_ptr<Relocalizer> relocalizer;
   if (s.robot) {
+    LocalizerOptions matcher;
+    matcher.noise = DetectedLineNoise();  // lines from LineExtractor
     localizer = std::make_unique<Localizer>(*loaded.model, loaded.regions.get(), loaded.area.get(),
-                                            s.camera, DetectedLineMatcherOptions({}));
+                                            s.camera, matcher);
     RelocalizationOptions relocalization;
     relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
     // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
