@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
@@ -347,8 +348,8 @@ int RunReplay(const ReplayOptions& opt) {
             << static_cast<int>(summary["throughput_fps"].get<double>())
             << " frames/s without the overlay";
   if (summary.contains("ground_truth")) {
-    std::cout << "; ATE " << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0
-              << " cm, worst "
+    std::cout << std::fixed << std::setprecision(2) << "; ATE "
+              << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0 << " cm, worst "
               << summary["ground_truth"]["translation_m"]["max"].get<double>() * 100.0 << " cm / "
               << summary["ground_truth"]["rotation_deg"]["max"].get<double>() << " deg";
   }
