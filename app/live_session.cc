@@ -72,6 +72,7 @@ void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
   sources.aravis.width = inputs.camera.width;
   sources.aravis.height = inputs.camera.height;
   sources.aravis.frame_rate = plan.camera_fps;
+  sources.aravis.latest_only = true;  // the servo acts on the newest frame, never a backlog
   source_ = OpenFrameSource(plan.source_spec, sources);
   head_ = OpenHead(plan.head_spec, HeadOptions{});
   const HeadGeometry geometry = GeometryOf(plan.head_model);

@@ -12,13 +12,6 @@
 
 namespace linetrack::app {
 
-LocalizerOptions DetectedLineMatcherOptions(LocalizerOptions base) {
-  base.noise = DetectedLineNoise();
-  base.verification.match_distance_px = 2.5;
-  base.verification.match_angle_deg = 2.0;
-  return base;
-}
-
 ImageLines ExtractImageLines(const std::string& image_path, const std::string& camera_path,
                              const std::string& camera_name, const LineFlags& flags) {
   const LineExtractionOptions options = flags.Options();

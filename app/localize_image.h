@@ -24,13 +24,6 @@ struct ImageLines {
   double ms = 0.0;  // extraction time
 };
 
-// The matcher's options for lines from LineExtractor (from `base`): the extractor's line noise
-// (DetectedLineNoise: 1 px, 0.3 deg) and verification that matches a line to an edge within
-// 2.5 px and 2 deg (the paper's margins, 6 px and 4 deg, let frame borders and objects standing
-// against walls, 2-8 px from the model edges, take the edges' place: bench localize-image,
-// docs/lines.md).
-LocalizerOptions DetectedLineMatcherOptions(LocalizerOptions base);
-
 // Reads the image and extracts its segments with the camera of `camera_path`. Throws
 // InputError naming the file when the image cannot be read, is empty or has another size.
 ImageLines ExtractImageLines(const std::string& image_path, const std::string& camera_path,

@@ -28,9 +28,14 @@ function(linetrack_add_test)
     LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
     LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")
   linetrack_strict_warnings(${ARG_NAME})
+  set(properties ${ARG_PROPERTIES})
+  if(LINETRACK_SANITIZE)  # leaks inside third-party libraries only; see the file
+    list(APPEND properties ENVIRONMENT
+         "LSAN_OPTIONS=suppressions=${LINETRACK_SOURCE_DIR}/tests/lsan_suppressions.txt")
+  endif()
   set(extra_properties)
-  if(ARG_PROPERTIES)
-    set(extra_properties PROPERTIES ${ARG_PROPERTIES})
+  if(properties)
+    set(extra_properties PROPERTIES ${properties})
   endif()
   gtest_discover_tests(${ARG_NAME} TEST_PREFIX "${ARG_PREFIX}." DISCOVERY_TIMEOUT 60
     WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR} ${extra_properties})

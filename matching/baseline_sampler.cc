@@ -14,26 +14,6 @@ bool BaselineOptions::Check(std::string* why) const {
   return true;
 }
 
-std::vector<Pose3Dof> MinimalPoses(const ObservedLine& line1, const MatchEdge& edge1,
-                                   const ObservedLine& line2, const MatchEdge& edge2,
-                                   double height) {
-  std::vector<Pose3Dof> poses;
-  const ObservedLine& heading_line = edge1.vertical ? line2 : line1;
-  const MatchEdge& heading_edge = edge1.vertical ? edge2 : edge1;
-  if (heading_edge.vertical) return poses;
-  for (double h : DirectionRoots(heading_line.normal, heading_edge.dir)) {
-    const Eigen::Vector3d l1 = PositionLine(line1.normal, edge1.mid, height, h);
-    const Eigen::Vector3d l2 = PositionLine(line2.normal, edge2.mid, height, h);
-    const double det = l1.x() * l2.y() - l1.y() * l2.x();
-    const double scale = std::hypot(l1.x(), l1.y()) * std::hypot(l2.x(), l2.y());
-    if (std::abs(det) < 1e-6 * scale) continue;  // parallel position lines
-    const double x = (l1.y() * l2.z() - l2.y() * l1.z()) / det;
-    const double y = (l2.x() * l1.z() - l1.x() * l2.z()) / det;
-    poses.push_back({x, y, h});
-  }
-  return poses;
-}
-
 std::vector<VerifiedPose> SampleAndVerify(const VerificationContext& context,
                                           const PriorRegion& prior, const BaselineOptions& options,
                                           const VerificationOptions& verification,

@@ -25,13 +25,6 @@ struct BaselineStats {
   int poses = 0;    // minimal poses inside the prior, verified (pose evaluations)
 };
 
-// Minimal poses from two correspondences at known height: the headings solving the direction
-// constraint of a non-vertical one (up to two), then the position where both position lines
-// cross. Empty when both edges are vertical or the lines are parallel.
-std::vector<Pose3Dof> MinimalPoses(const ObservedLine& line1, const MatchEdge& edge1,
-                                   const ObservedLine& line2, const MatchEdge& edge2,
-                                   double height);
-
 // Draws pairs, verifies the minimal poses inside the prior (with `gate` margins on the heading
 // and the disk), and returns every verified pose.
 std::vector<VerifiedPose> SampleAndVerify(const VerificationContext& context,

@@ -64,7 +64,7 @@ Eigen::Vector3d DirectionCoefficients(const Eigen::Vector3d& n, const Eigen::Vec
 
 std::vector<double> DirectionRoots(const Eigen::Vector3d& normal, const Eigen::Vector3d& v) {
   const Eigen::Vector3d abc = DirectionCoefficients(normal, v);
-  const double rho = std::hypot(abc.x(), abc.y());
+  const double rho = std::sqrt(abc.x() * abc.x() + abc.y() * abc.y());
   if (rho < 1e-15 || std::abs(abc.z()) > rho) return {};
   const double alpha = std::atan2(abc.y(), abc.x());
   const double theta = std::acos(std::clamp(-abc.z() / rho, -1.0, 1.0));
@@ -77,7 +77,7 @@ std::vector<HeadingInterval> DirectionIntervals(const ObservedLine& line, const 
   const Eigen::Vector3d abc = DirectionCoefficients(line.normal, v);
   const double tolerance =
       sigmas * std::sqrt(FormVariance(line, LevelFromWorld(prior.Mid()) * v)) + 1e-12;
-  const double rho = std::hypot(abc.x(), abc.y());
+  const double rho = std::sqrt(abc.x() * abc.x() + abc.y() * abc.y());
   std::vector<HeadingInterval> out;
   if (rho < 1e-12) {  // g1 does not depend on h (vertical edge): all or nothing
     if (std::abs(abc.z()) <= tolerance) out.push_back(prior);
@@ -108,15 +108,22 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p,
 
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double heading, const Eigen::Vector2d& at, double sigmas) {
-  const Eigen::Vector3d w = LevelFromWorld(heading) * (p - Eigen::Vector3d(at.x(), at.y(), height));
-  const Eigen::Vector3d l = PositionLine(line.normal, p, height, heading);
-  const double ab = std::hypot(l.x(), l.y());
+  return PositionBandHalfWidth(line, p, height, std::cos(heading), std::sin(heading), at, sigmas);
+}
+
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double ch, double sh, const Eigen::Vector2d& at, double sigmas) {
+  // Rl(h) (p - C), Rl(h) with rows (sin h, -cos h, 0), (0, 0, -1), (cos h, sin h, 0).
+  const Eigen::Vector3d d = p - Eigen::Vector3d(at.x(), at.y(), height);
+  const Eigen::Vector3d w(sh * d.x() - ch * d.y(), -d.z(), ch * d.x() + sh * d.y());
+  const Eigen::Vector3d l = PositionLine(line.normal, p, height, ch, sh);
+  const double ab = std::sqrt(l.x() * l.x() + l.y() * l.y());
   if (ab < 1e-12) return std::numeric_limits<double>::infinity();
   return sigmas * std::sqrt(FormVariance(line, w)) / ab;
 }
 
 double DistanceToLine(const Eigen::Vector3d& l, const Eigen::Vector2d& q) {
-  return std::abs(l.x() * q.x() + l.y() * q.y() + l.z()) / std::hypot(l.x(), l.y());
+  return std::abs(l.x() * q.x() + l.y() * q.y() + l.z()) / std::sqrt(l.x() * l.x() + l.y() * l.y());
 }
 
 // The point of the edge's line seen along the segment's middle ray from camera position `at`
@@ -164,7 +171,7 @@ bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double heig
                     double focal_px) {
   const Eigen::Vector3d p = ObservedPointOnEdge(line, edge, height, heading, centre);
   const Eigen::Vector3d l = PositionLine(line.normal, p, height, heading);
-  const double ab = std::hypot(l.x(), l.y());
+  const double ab = std::sqrt(l.x() * l.x() + l.y() * l.y());
   if (ab < 1e-12) return true;
   const Eigen::Vector2d n(l.x() / ab, l.y() / ab);
   const double offset = n.dot(centre) + l.z() / ab;
@@ -208,7 +215,7 @@ bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge, dou
   const double z_lo = std::min(edge.a.z(), edge.b.z()) - height;
   const double z_hi = std::max(edge.a.z(), edge.b.z()) - height;
   for (const Eigen::Vector3d& ray : {line.ray_a, line.ray_b}) {
-    const double horizontal = std::hypot(ray.x(), ray.z());
+    const double horizontal = std::sqrt(ray.x() * ray.x() + ray.z() * ray.z());
     if (horizontal < 1e-9) continue;
     const double t = -ray.y() / horizontal;  // tan(elevation), level y points down
     const double tau = slack_px / focal_px * (1.0 + t * t);
@@ -241,7 +248,8 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
       const double h = j.lo + j.Width() * k / steps;
       const Eigen::Vector3d p = ObservedPointOnEdge(line, edge, height, h, centre);
       const Eigen::Vector3d l = PositionLine(line.normal, p, height, h);
-      const double s = (l.x() * centre.x() + l.y() * centre.y() + l.z()) / std::hypot(l.x(), l.y());
+      const double s = (l.x() * centre.x() + l.y() * centre.y() + l.z()) /
+                       std::sqrt(l.x() * l.x() + l.y() * l.y());
       const int sg = s > 0.0 ? 1 : -1;
       crosses = crosses || (sign != 0 && sg != sign);
       sign = sg;
@@ -315,9 +323,34 @@ HeadingInterval InscribedAngleRange(const Eigen::Vector2d& foot1, const Eigen::V
 
 bool BinaryVertical(const ObservedLine& line1, const ObservedLine& line2,
                     const HeadingInterval& range, double sigmas) {
-  const double expected = WrapAngle(line2.bearing - line1.bearing);
-  const double tolerance = sigmas * std::hypot(line1.bearing_sigma, line2.bearing_sigma);
+  // Bearings lie in (-pi, pi]: their difference needs at most one turn added or removed.
+  double expected = line2.bearing - line1.bearing;
+  if (expected > kPi) expected -= 2.0 * kPi;
+  if (expected <= -kPi) expected += 2.0 * kPi;
+  const double tolerance = sigmas * std::sqrt(line1.bearing_sigma * line1.bearing_sigma +
+                                              line2.bearing_sigma * line2.bearing_sigma);
   return expected >= range.lo - tolerance && expected <= range.hi + tolerance;
+}
+
+std::vector<Pose3Dof> MinimalPoses(const ObservedLine& line1, const MatchEdge& edge1,
+                                   const ObservedLine& line2, const MatchEdge& edge2,
+                                   double height) {
+  std::vector<Pose3Dof> poses;
+  const ObservedLine& heading_line = edge1.vertical ? line2 : line1;
+  const MatchEdge& heading_edge = edge1.vertical ? edge2 : edge1;
+  if (heading_edge.vertical) return poses;
+  for (double h : DirectionRoots(heading_line.normal, heading_edge.dir)) {
+    const Eigen::Vector3d l1 = PositionLine(line1.normal, edge1.mid, height, h);
+    const Eigen::Vector3d l2 = PositionLine(line2.normal, edge2.mid, height, h);
+    const double det = l1.x() * l2.y() - l1.y() * l2.x();
+    const double scale =
+        std::sqrt(l1.x() * l1.x() + l1.y() * l1.y()) * std::sqrt(l2.x() * l2.x() + l2.y() * l2.y());
+    if (std::abs(det) < 1e-6 * scale) continue;  // parallel position lines
+    const double x = (l1.y() * l2.z() - l2.y() * l1.z()) / det;
+    const double y = (l2.x() * l1.z() - l1.x() * l2.z()) / det;
+    poses.push_back({x, y, h});
+  }
+  return poses;
 }
 
 }  // namespace linetrack

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "matching/observed_line.h"
+#include "models/robot_pose.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -74,6 +75,9 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& normal, const Eigen::Vector3
 // sigmas * std(g2) / |(A, B)|.
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double heading, const Eigen::Vector2d& at, double sigmas);
+// The same with cos h, sin h given (hot loops).
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas);
 
 // The point of the edge (clamped to it) seen along the segment's middle ray from camera
 // position `at` at heading h: the closest point of the edge's line to that viewing ray. The
@@ -132,5 +136,12 @@ HeadingInterval InscribedAngleRange(const Eigen::Vector2d& foot1, const Eigen::V
 // w_2 - w_1 within `range` (InscribedAngleRange of the feet) widened by the noise.
 bool BinaryVertical(const ObservedLine& line1, const ObservedLine& line2,
                     const HeadingInterval& range, double sigmas);
+
+// Minimal poses from two correspondences at known height: the headings solving the direction
+// constraint of a non-vertical one (up to two), then the position where both position lines
+// cross. Empty when both edges are vertical or the lines are parallel.
+std::vector<Pose3Dof> MinimalPoses(const ObservedLine& line1, const MatchEdge& edge1,
+                                   const ObservedLine& line2, const MatchEdge& edge2,
+                                   double height);
 
 }  // namespace linetrack

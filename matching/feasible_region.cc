@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace linetrack {
 namespace {
@@ -98,9 +99,30 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
 
 void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
                              const Eigen::Vector2d& n2, double d2) {
-  ConvexPolygon half;
-  half.ClipFrom(source, n1, d1);
-  ClipFrom(half, n2, d2);
+  // Most cuts keep a polygon whole or drop it: decide those from the vertices' sides first.
+  bool all1 = true, all2 = true, any1 = false, any2 = false;
+  for (int i = 0; i < source.count_; ++i) {
+    const bool in1 = n1.dot(source.vertices_[i]) + d1 >= 0.0;
+    const bool in2 = n2.dot(source.vertices_[i]) + d2 >= 0.0;
+    all1 = all1 && in1;
+    all2 = all2 && in2;
+    any1 = any1 || in1;
+    any2 = any2 || in2;
+  }
+  if (!any1 || !any2) {
+    count_ = 0;
+  } else if (all1 && all2) {
+    std::copy(source.begin(), source.end(), vertices_.begin());
+    count_ = source.count_;
+  } else if (all1) {
+    ClipFrom(source, n2, d2);
+  } else if (all2) {
+    ClipFrom(source, n1, d1);
+  } else {
+    ConvexPolygon half;
+    half.ClipFrom(source, n1, d1);
+    ClipFrom(half, n2, d2);
+  }
 }
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {
@@ -121,7 +143,50 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
     const double hi = heading.lo + heading.Width() * (i + 1) / count;
     region.bins.push_back({lo, hi, Trig(lo), Trig(0.5 * (lo + hi)), Trig(hi), disk});
   }
+  region.UpdateBox();
   return region;
+}
+
+void FeasibleRegion::UpdateBox() {
+  box_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  box_hi = -box_lo;
+  for (const HeadingBin& bin : bins) {
+    for (const Eigen::Vector2d& q : bin.positions) {
+      box_lo = box_lo.cwiseMin(q);
+      box_hi = box_hi.cwiseMax(q);
+    }
+  }
+}
+
+bool FeasibleRegion::Contains(const Pose3Dof& pose) const {
+  const Eigen::Vector2d q(pose.x, pose.y);
+  for (const HeadingBin& bin : bins) {
+    const double h = pose.heading + 2.0 * kPi * std::round((bin.lo - pose.heading) / (2.0 * kPi));
+    if (h < bin.lo || h > bin.hi || bin.positions.Empty()) continue;
+    bool inside = true;
+    const Eigen::Vector2d* v = bin.positions.begin();
+    const int n = bin.positions.size();
+    for (int i = 0; i < n && inside; ++i)
+      inside = Cross2(v[(i + 1) % n] - v[i], q - v[i]) >= 0.0;
+    if (inside) return true;
+  }
+  return false;
+}
+
+bool FeasibleRegion::Within(const Pose3Dof& pose, double radius, double heading_margin) const {
+  if (bins.empty()) return false;
+  // The bins' headings run continuously: bring the pose's heading next to them once.
+  const double h =
+      pose.heading + 2.0 * kPi * std::round((bins.front().lo - pose.heading) / (2.0 * kPi));
+  if (bins.front().lo < h - heading_margin || bins.back().hi > h + heading_margin) return false;
+  const double r2 = radius * radius;
+  const Eigen::Vector2d q(pose.x, pose.y);
+  for (const HeadingBin& bin : bins) {
+    for (const Eigen::Vector2d& v : bin.positions) {
+      if ((v - q).squaredNorm() > r2) return false;
+    }
+  }
+  return true;
 }
 
 void FeasibleRegion::Refine(int max_bins, double min_width) {
@@ -153,6 +218,76 @@ std::vector<Pose3Dof> FeasibleRegion::Representatives() const {
   return poses;
 }
 
+namespace {
+
+// The band of positions a non-vertical correspondence allows in `bin`: |s(q)| <= half_width with
+// s the signed distance to the unit position line at the bin's mid heading, widened by how far
+// the line moves within the bin (its offset is affine in the position, so the polygon's vertices
+// bound the change).
+struct Band {
+  Eigen::Vector2d normal;
+  double offset = 0.0;  // s(q) = normal . q + offset
+  double half_width = 0.0;
+};
+
+Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                     const HeadingBin& bin) {
+  const Eigen::Vector2d centre = bin.positions.Centroid();
+  const Eigen::Vector3d p =
+      ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
+  const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
+  const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
+  const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
+  double slack = 0.0;
+  for (const Eigen::Vector2d& q : bin.positions) {
+    const double s = SignedDistance(mid, q);
+    slack =
+        std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
+  }
+  return {
+      Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
+      PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas) +
+          slack};
+}
+
+}  // namespace
+
+VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double sigmas)
+    : foot_(edge.foot),
+      bearing_(line.bearing),
+      margin_(sigmas * line.bearing_sigma),
+      a_(Trig(-line.bearing - margin_ + kPi)),
+      b_(Trig(-line.bearing + margin_ + kPi)) {}
+
+bool VerticalCut::In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
+                     double* d2) const {
+  if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
+  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+  };
+  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
+  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+  *d1 = -n1->dot(foot_);
+  *d2 = -n2->dot(foot_);
+  return true;
+}
+
+bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
+  if (in.Empty()) return false;
+  const HeadingInterval heading = in.Heading();
+  if (heading.Width() + 2.0 * margin_ >= kPi) return true;
+  const Eigen::Vector2d centre = 0.5 * (in.box_lo + in.box_hi);
+  const double reach = 0.5 * (in.box_hi - in.box_lo).norm();
+  const Eigen::Vector2d to_box = centre - foot_;
+  const double distance = to_box.norm();
+  if (distance <= reach) return true;
+  const double spread = std::asin(reach / distance);
+  const double wanted = heading.Mid() - bearing_ + kPi;
+  const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
+  return offset <= spread + 0.5 * heading.Width() + margin_;
+}
+
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
@@ -161,75 +296,87 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
       DirectionIntervals(line, edge.dir, in.Heading(), sigmas);
   for (const HeadingBin& bin : in.bins) {
     if (!Overlaps(bin, parts)) continue;
-    const Eigen::Vector2d centre = bin.positions.Centroid();
-    const Eigen::Vector3d p =
-        ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
-    const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
-    const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
-    const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
-    // The line moves within the bin: its offset is affine in the position, so the polygon's
-    // vertices bound the change.
-    double slack = 0.0;
-    for (const Eigen::Vector2d& q : bin.positions) {
-      const double s = SignedDistance(mid, q);
-      slack = std::max(
-          {slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
-    }
-    const double half_width =
-        PositionBandHalfWidth(line, p, height, 0.5 * (bin.lo + bin.hi), centre, sigmas) + slack;
+    const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
     // |s(q)| <= half_width: two half-planes of the unit line.
-    const Eigen::Vector2d n(mid.x(), mid.y());
     HeadingBin& cut = Append(bin, out);
-    cut.positions.ClipFrom(bin.positions, -n, half_width - mid.z(), n, half_width + mid.z());
+    cut.positions.ClipFrom(bin.positions, -band.normal, band.half_width - band.offset, band.normal,
+                           band.half_width + band.offset);
     if (cut.positions.Empty()) out->bins.pop_back();
   }
+  out->UpdateBox();
+  return !out->Empty();
+}
+
+bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                      const FeasibleRegion& region) {
+  if (region.Empty()) return false;
+  const std::vector<HeadingInterval> parts =
+      DirectionIntervals(line, edge.dir, region.Heading(), sigmas);
+  if (parts.empty()) return false;
+  for (const HeadingBin& bin : region.bins) {
+    if (!Overlaps(bin, parts)) continue;
+    const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Eigen::Vector2d& q : bin.positions) {
+      const double s = band.normal.dot(q) + band.offset;
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    if (hi >= -band.half_width && lo <= band.half_width) return true;
+  }
+  return false;
+}
+
+bool AddVertical(const VerticalCut& cut, const FeasibleRegion& in, FeasibleRegion* out) {
+  out->bins.clear();
+  if (!cut.MayMeet(in)) return false;
+  for (const HeadingBin& bin : in.bins) {
+    HeadingBin& kept = Append(bin, out);
+    Eigen::Vector2d n1, n2;
+    double d1 = 0.0, d2 = 0.0;
+    if (!cut.In(bin, &n1, &d1, &n2, &d2)) {
+      kept.positions = bin.positions;
+      continue;
+    }
+    kept.positions.ClipFrom(bin.positions, n1, d1, n2, d2);
+    if (kept.positions.Empty()) out->bins.pop_back();
+  }
+  out->UpdateBox();
   return !out->Empty();
 }
 
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  const FeasibleRegion& in, FeasibleRegion* out) {
-  out->bins.clear();
-  const double margin = sigmas * line.bearing_sigma;
-  // Camera directions from the foot: (h - w) + pi for h in the bin, widened by the margin:
-  // from bin.lo + a to bin.hi + b, rotated with the cached bin trigonometry.
-  const Eigen::Vector2d a = Trig(-line.bearing - margin + kPi),
-                        b = Trig(-line.bearing + margin + kPi);
-  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-  };
-  // Quick reject: the directions from the foot to the region's bounding box must meet the
-  // camera directions the headings allow.
-  if (!in.Empty() && in.Heading().Width() + 2.0 * margin < kPi) {
-    Eigen::Vector2d lo = *in.bins.front().positions.begin(), hi = lo;
-    for (const HeadingBin& bin : in.bins) {
-      for (const Eigen::Vector2d& q : bin.positions) {
-        lo = lo.cwiseMin(q);
-        hi = hi.cwiseMax(q);
-      }
+  return AddVertical(VerticalCut(line, edge, sigmas), in, out);
+}
+
+bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region) {
+  if (region.bins.size() > 4 && !cut.MayMeet(region)) return false;
+  ConvexPolygon scratch;
+  for (const HeadingBin& bin : region.bins) {
+    Eigen::Vector2d n1, n2;
+    double d1 = 0.0, d2 = 0.0;
+    if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
+    // Quick answers before clipping: every vertex outside one half-plane (no), or inside both
+    // (yes).
+    bool all_in = true, any_in1 = false, any_in2 = false;
+    for (const Eigen::Vector2d& q : bin.positions) {
+      const bool in1 = n1.dot(q) + d1 >= 0.0, in2 = n2.dot(q) + d2 >= 0.0;
+      any_in1 = any_in1 || in1;
+      any_in2 = any_in2 || in2;
+      all_in = all_in && in1 && in2;
     }
-    const Eigen::Vector2d centre = 0.5 * (lo + hi);
-    const double reach = 0.5 * (hi - lo).norm();
-    const Eigen::Vector2d to_box = centre - edge.foot;
-    const double distance = to_box.norm();
-    if (distance > reach) {
-      const double spread = std::asin(reach / distance);
-      const double wanted = 0.5 * (in.Heading().lo + in.Heading().hi) - line.bearing + kPi;
-      const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
-      if (offset > spread + 0.5 * in.Heading().Width() + margin) return false;
-    }
+    if (all_in && !bin.positions.Empty()) return true;
+    if (!any_in1 || !any_in2) continue;
+    scratch.ClipFrom(bin.positions, n1, d1, n2, d2);
+    if (!scratch.Empty()) return true;
   }
-  for (const HeadingBin& bin : in.bins) {
-    HeadingBin& cut = Append(bin, out);
-    if (bin.hi - bin.lo + 2.0 * margin >= kPi) {
-      cut.positions = bin.positions;
-      continue;
-    }
-    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a), u2 = rotate(bin.trig_hi, b);
-    const Eigen::Vector2d n1(-u1.y(), u1.x()), n2(u2.y(), -u2.x());
-    cut.positions.ClipFrom(bin.positions, n1, -n1.dot(edge.foot), n2, -n2.dot(edge.foot));
-    if (cut.positions.Empty()) out->bins.pop_back();
-  }
-  return !out->Empty();
+  return false;
+}
+
+bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const FeasibleRegion& region) {
+  return MeetsVertical(VerticalCut(line, edge, sigmas), region);
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,

@@ -54,12 +54,20 @@ struct HeadingBin {
 
 struct FeasibleRegion {
   std::vector<HeadingBin> bins;  // ordered by heading, non-empty polygons
+  // Bounding box of the positions of all bins (UpdateBox; kept by FromPrior and the cuts).
+  Eigen::Vector2d box_lo = Eigen::Vector2d::Zero(), box_hi = Eigen::Vector2d::Zero();
+  void UpdateBox();
 
   // Bins of at most `bin_width` radians covering `heading`, each with the polygon around the disk.
   static FeasibleRegion FromPrior(const HeadingInterval& heading, const Eigen::Vector2d& centre,
                                   double radius, double bin_width);
 
   bool Empty() const { return bins.empty(); }
+  // True when some bin holds the pose (its heading, modulo 2 pi, and its position).
+  bool Contains(const Pose3Dof& pose) const;
+  // True when every bin's headings lie within `heading_margin` of pose.heading and every
+  // polygon vertex within `radius` of its position.
+  bool Within(const Pose3Dof& pose, double radius, double heading_margin) const;
   // Hull of the surviving headings.
   HeadingInterval Heading() const { return {bins.front().lo, bins.back().hi}; }
   // Representative poses: for each run of contiguous surviving bins, the middle bin's heading
@@ -81,11 +89,43 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                     const FeasibleRegion& in, FeasibleRegion* out);
 
+// True when the non-vertical correspondence keeps some of `region` (AddNonVertical would not
+// empty it), without building the cut.
+bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
+                      const FeasibleRegion& region);
+
+// A vertical correspondence as a cut of the region: in a bin of headings [lo, hi] the camera
+// lies in the wedge of directions (h - w) + pi from the edge's foot, h in the bin, widened by
+// sigmas times the bearing noise. Built once per (line, edge) pair for many cuts.
+class VerticalCut {
+ public:
+  VerticalCut(const ObservedLine& line, const MatchEdge& edge, double sigmas);
+  // The wedge in `bin`: n1 . q + d1 >= 0 and n2 . q + d2 >= 0; false when the bin is too wide
+  // for a wedge (everything allowed).
+  bool In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
+          double* d2) const;
+  // Quick test: the directions from the foot to the region's bounding box meet those the
+  // headings allow (false: the cut empties the region).
+  bool MayMeet(const FeasibleRegion& region) const;
+
+ private:
+  Eigen::Vector2d foot_;
+  double bearing_ = 0.0;
+  double margin_ = 0.0;
+  Eigen::Vector2d a_, b_;  // (cos, sin) of -w -+ margin + pi
+};
+
 // Cuts `region` with a vertical correspondence: each bin's polygon is clipped to the wedge of
 // rays from the foot for the bin's headings (widened by the bearing noise).
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  FeasibleRegion* region);
 bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
                  const FeasibleRegion& in, FeasibleRegion* out);
+// True when the vertical correspondence keeps some of `region`, without building the cut.
+bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
+                   const FeasibleRegion& region);
+// The same with the cut built beforehand.
+bool AddVertical(const VerticalCut& cut, const FeasibleRegion& in, FeasibleRegion* out);
+bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region);
 
 }  // namespace linetrack

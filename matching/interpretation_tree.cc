@@ -1,90 +1,152 @@
 #include "matching/interpretation_tree.h"
 
+#include "matching/line_fit.h"
+
 #include <algorithm>
 #include <numeric>
 #include <optional>
+#include <set>
 
 namespace linetrack {
 namespace {
 
-// One level of the tree: a model edge and the lines that pass its unary constraint, with the
-// heading interval each allows.
-struct Level {
-  int edge = -1;
-  std::vector<int> lines;
-  std::vector<HeadingInterval> headings;
-};
-
+// The tree is searched line by line (the data-driven order of Grimson's interpretation tree):
+// each image line is assigned one of its candidate model edges or none (clutter). An edge may
+// take several lines when they do not overlap along it (fragments). Correspondence sets are the
+// same as with the edge-major order of Ait Aider et al.; this order makes the bound tight: every
+// line left unexplained removes its cap from the bound at once.
 class TreeSearch {
  public:
   TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
              const PriorRegion& prior, const InterpretationTreeOptions& options,
-             const LeafVisitor& visit, InterpretationTreeStats* stats)
+             const std::vector<double>& line_caps, const LeafVisitor& visit,
+             InterpretationTreeStats* stats, const std::vector<VerifiedBasin>* basins)
       : edges_(edges),
         lines_(lines),
         prior_(prior),
         options_(options),
         visit_(visit),
         stats_(stats),
-        min_matches_(options.min_matches) {
+        basins_(basins) {
     gate_.sigmas = options.gate_sigmas;
     gate_.extent_slack_px = options.extent_slack_px;
     gate_.focal_px = prior.focal_px;
+    caps_ = line_caps.empty() ? std::vector<double>(lines.size(), 1.0) : line_caps;
   }
 
   void Run() {
-    BuildLevels();
+    BuildCandidates();
     const double min_width = DegToRad(options_.heading_bin_deg);
-    const FeasibleRegion root =
+    FeasibleRegion root =
         FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
                                   std::max(min_width, prior_.heading.Width() / options_.max_bins));
-    used_.assign(lines_.size(), false);
-    reachable_lines_.assign(lines_.size(), false);
-    suffix_.assign(levels_.size() + 1, 0);
-    regions_.resize(levels_.size() + 2);
-    for (int i = static_cast<int>(levels_.size()) - 1; i >= 0; --i)
-      suffix_[i] = suffix_[i + 1] + 1;
-    Search(0, root);
+    if (prior_.has_bounds) {
+      for (HeadingBin& bin : root.bins) {
+        bin.positions.ClipHalfPlane({1.0, 0.0}, -prior_.bounds_min.x());
+        bin.positions.ClipHalfPlane({-1.0, 0.0}, prior_.bounds_max.x());
+        bin.positions.ClipHalfPlane({0.0, 1.0}, -prior_.bounds_min.y());
+        bin.positions.ClipHalfPlane({0.0, -1.0}, prior_.bounds_max.y());
+      }
+      if (root.bins.front().positions.Empty()) return;
+      root.UpdateBox();
+    }
+    const size_t n = lines_.size();
+    decided_.assign(n, kUndecided);
+    edge_lines_.assign(edges_.size(), 0);
+    regions_.resize(n + 2);
+    alive_.assign(n + 2, std::vector<char>(candidate_edge_.size(), 1));
+    // Iterative deepening on the bound: from what all lines with a candidate could give, down
+    // by deepening_lines mean caps or deepening_fraction of the bound per pass (the larger),
+    // until the visitor's own bound is reached.
+    double top = 0.0;
+    int with_candidates = 0;
+    for (size_t j = 0; j < n; ++j) {
+      if (line_offsets_[j] == line_offsets_[j + 1]) continue;
+      top += caps_[j];
+      ++with_candidates;
+    }
+    if (with_candidates == 0) return;
+    const double step = options_.deepening_lines * top / with_candidates;
+    for (double pass = top - std::max(step, options_.deepening_fraction * top);;
+         pass -= std::max(step, options_.deepening_fraction * pass)) {
+      pass_bound_ = std::max(pass, 0.0);
+      ++stats_->passes;
+      Search(0, root);
+      if (stats_->budget_exhausted || pass_bound_ <= visitor_bound_ || pass_bound_ <= 0.0) break;
+    }
   }
 
  private:
-  // Unary constraints: non-vertical edges against all lines, vertical edges against the lines
-  // that can be images of vertical edges. Non-vertical levels first (they narrow the heading, so
-  // the vertical wedges then cut few bins), each group by candidate count, fewest first.
-  void BuildLevels() {
-    for (size_t e = 0; e < edges_.size(); ++e) {
-      Level level;
-      level.edge = static_cast<int>(e);
-      for (size_t j = 0; j < lines_.size(); ++j) {
+  static constexpr int kUndecided = -1;
+  static constexpr int kClutter = -2;
+  static constexpr double kFragmentGateChi2 = 13.8;  // 99.9 % of chi-square with 2 dof
+
+  // Unary constraints: each line against the non-vertical edges and, when it can be the image of
+  // a vertical edge, against the vertical ones. Lines are searched by decreasing cap: leaving
+  // those unexplained lowers the bound most, so wrong branches are cut soonest (measured better
+  // than longest first on the benchmark: 98.4 against 97.9 % correct at QI2).
+  void BuildCandidates() {
+    order_.resize(lines_.size());
+    std::iota(order_.begin(), order_.end(), 0);
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](int a, int b) { return caps_[a] > caps_[b]; });
+    // Only the max_lines lines with the largest caps enter the tree (the budget: many clutter
+    // lines); guided matching still sees all of them.
+    std::vector<bool> in_tree(lines_.size(), false);
+    for (size_t k = 0; k < order_.size() && static_cast<int>(k) < options_.max_lines; ++k)
+      in_tree[order_[k]] = true;
+    line_offsets_.assign(1, 0);
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      for (size_t e = 0; e < edges_.size() && in_tree[j]; ++e) {
+        bool pass = false;
         if (edges_[e].vertical) {
-          if (!lines_[j].maybe_vertical) continue;
-          const std::optional<HeadingInterval> h =
-              UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                            prior_.radius, gate_);
-          if (!h) continue;
-          level.lines.push_back(static_cast<int>(j));
-          level.headings.push_back(*h);
+          pass = lines_[j].maybe_vertical &&
+                 UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
+                               prior_.radius, gate_)
+                     .has_value();
         } else {
-          const std::vector<HeadingInterval> h =
-              UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                               prior_.radius, gate_);
-          if (h.empty()) continue;
-          level.lines.push_back(static_cast<int>(j));
-          level.headings.push_back({h.front().lo, h.back().hi});
+          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
+                                   prior_.centre, prior_.radius, gate_)
+                      .empty();
         }
+        if (!pass) continue;
+        candidate_edge_.push_back(static_cast<int>(e));
+        candidate_line_.push_back(static_cast<int>(j));
+        cuts_.push_back(edges_[e].vertical
+                            ? std::optional<VerticalCut>(std::in_place, lines_[j], edges_[e],
+                                                         options_.gate_sigmas)
+                            : std::nullopt);
       }
-      stats_->unary_candidates += static_cast<int>(level.lines.size());
-      if (!level.lines.empty()) levels_.push_back(std::move(level));
+      line_offsets_.push_back(static_cast<int>(candidate_edge_.size()));
     }
-    std::stable_sort(levels_.begin(), levels_.end(), [&](const Level& a, const Level& b) {
-      if (edges_[a.edge].vertical != edges_[b.edge].vertical) return !edges_[a.edge].vertical;
-      return a.lines.size() < b.lines.size();
-    });
+    stats_->unary_candidates = static_cast<int>(candidate_edge_.size());
+  }
+
+  // True when `line` cannot be a further fragment of `edge`'s image: it overlaps (beyond the
+  // slack) a line already assigned to it, or does not lie on the same line.
+  bool OverlapsAssigned(int edge, int line) const {
+    if (edge_lines_[edge] == 0) return false;
+    const Segment2& s = lines_[line].pixels;
+    const Eigen::Vector2d axis = (s.b - s.a) / s.Length();
+    const double tolerance = gate_.extent_slack_px;
+    for (const auto& [e, l] : assigned_) {
+      if (e != edge) continue;
+      const Segment2& t = lines_[l].pixels;
+      const double t0 = (t.a - s.a).dot(axis), t1 = (t.b - s.a).dot(axis);
+      const double overlap =
+          std::min(std::max(t0, t1), s.Length()) - std::max(std::min(t0, t1), 0.0);
+      if (overlap > tolerance ||
+          FragmentChiSquare(t, s, options_.fragment_offset_px) > kFragmentGateChi2) {
+        return true;
+      }
+    }
+    return false;
   }
 
   // Writes `in` cut by (edge, line) into `out`; false when the pose set becomes empty or a binary
   // vertical constraint with an assigned vertical correspondence fails.
-  bool Extend(int edge, int line, const FeasibleRegion& in, FeasibleRegion* out) const {
+  bool Extend(int c, const FeasibleRegion& in, FeasibleRegion* out) const {
+    const int edge = candidate_edge_[c], line = candidate_line_[c];
     const MatchEdge& e = edges_[edge];
     const ObservedLine& l = lines_[line];
     if (!e.vertical) return AddNonVertical(l, e, prior_.height, options_.gate_sigmas, in, out);
@@ -97,57 +159,144 @@ class TreeSearch {
         return false;
       }
     }
-    return AddVertical(l, e, options_.gate_sigmas, in, out);
+    return AddVertical(*cuts_[c], in, out);
   }
 
+  double Bound() const { return std::max(pass_bound_, visitor_bound_); }
+
+  // One node: `depth` lines decided. The next line is the first undecided one (in cap order)
+  // with a candidate still alive; lines without one are clutter for free (their cap is no longer
+  // in the bound).
   void Search(size_t depth, const FeasibleRegion& region) {
-    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses) {
+    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses ||
+        stats_->checks >= options_.max_checks) {
       stats_->budget_exhausted = true;
       return;
     }
     ++stats_->nodes;
-    if (static_cast<int>(assigned_.size()) + suffix_[depth] < min_matches_ ||
-        static_cast<int>(assigned_.size()) + Reachable(depth, region) < min_matches_) {
+    const std::vector<char>& alive = alive_[depth];
+    double reachable = 0.0;
+    int open_lines = 0, next = -1;
+    for (int j : order_) {
+      if (decided_[j] != kUndecided) continue;
+      bool any = false;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1] && !any; ++c)
+        any = alive[c];
+      if (!any) continue;
+      reachable += caps_[j];
+      ++open_lines;
+      if (next < 0) next = j;
+    }
+    if (distinct_edges_ + open_lines < options_.min_matches ||
+        assigned_caps_ + reachable < Bound() || InBasin(region) || VerifiedAgain(open_lines)) {
       return;
     }
-    if (depth == levels_.size()) {
-      if (IsMaximal(region)) {
-        ++stats_->leaves;
-        min_matches_ = std::max(min_matches_, visit_(Hypothesis{assigned_, region}));
-      }
+    if (next < 0) {
+      VisitLeaf(alive, region);
       return;
     }
-    const Level& level = levels_[depth];
-    const bool vertical = edges_[level.edge].vertical;
-    const HeadingInterval headings = region.Heading();
-    for (size_t c = 0; c < level.lines.size(); ++c) {
-      const int line = level.lines[c];
-      if (used_[line] || (vertical && VerticalsFull())) continue;
-      // Cheap test first: the candidate's unary heading interval must meet the region's.
-      if (level.headings[c].lo > headings.hi || level.headings[c].hi < headings.lo) continue;
+    for (int c = line_offsets_[next]; c < line_offsets_[next + 1]; ++c) {
+      const int edge = candidate_edge_[c];
+      if (!alive[c] || OverlapsAssigned(edge, next)) continue;
       // Regions live in one buffer per depth, reused: copying keeps their capacity.
-      FeasibleRegion& next = regions_[depth + 1];
-      if (!Extend(level.edge, line, region, &next)) continue;
-      next.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
-      used_[line] = true;
-      assigned_.emplace_back(level.edge, line);
-      assigned_verticals_ += vertical ? 1 : 0;
-      Search(depth + 1, next);
-      assigned_verticals_ -= vertical ? 1 : 0;
+      FeasibleRegion& cut = regions_[depth + 1];
+      if (!Extend(c, region, &cut)) continue;
+      cut.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
+      decided_[next] = c;
+      assigned_.emplace_back(edge, next);
+      assigned_caps_ += caps_[next];
+      distinct_edges_ += edge_lines_[edge]++ == 0 ? 1 : 0;
+      for (size_t b = 0; b < basin_fit_.size(); ++b)
+        basin_fit_[b] += basin_flags_[b][c];
+      ForwardCheck(depth, cut, edge, next);
+      Search(depth + 1, cut);
+      for (size_t b = 0; b < basin_fit_.size(); ++b)
+        basin_fit_[b] -= basin_flags_[b][c];
+      distinct_edges_ -= --edge_lines_[edge] == 0 ? 1 : 0;
+      assigned_caps_ -= caps_[next];
       assigned_.pop_back();
-      used_[line] = false;
+      decided_[next] = kUndecided;
     }
-    skipped_.push_back(static_cast<int>(depth));
+    decided_[next] = kClutter;
+    alive_[depth + 1] = alive;
     Search(depth + 1, region);
-    skipped_.pop_back();
+    decided_[next] = kUndecided;
   }
 
-  // The tree assigns at most options_.max_vertical_matches vertical correspondences: they are
-  // weakly constrained one by one (many similar vertical lines and edges), so once a few fix the
-  // pose with the non-vertical ones, the verification's guided matching finds the others.
-  bool VerticalsFull() const {
-    return options_.max_vertical_matches > 0 &&
-           assigned_verticals_ >= options_.max_vertical_matches;
+  // Forward checking: the candidates of lines not assigned that stay consistent with `region`
+  // after (edge, line) was assigned, written to alive_[depth + 1].
+  void ForwardCheck(size_t depth, const FeasibleRegion& region, int edge, int line) {
+    const std::vector<char>& in = alive_[depth];
+    std::vector<char>& out = alive_[depth + 1];
+    const bool vertical = edges_[edge].vertical;
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      const bool assigned = decided_[j] >= 0;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
+        out[c] = 0;
+        if (assigned || !in[c]) continue;
+        ++stats_->checks;
+        const MatchEdge& e = edges_[candidate_edge_[c]];
+        const ObservedLine& l = lines_[j];
+        if (e.vertical) {
+          if (vertical && !BinaryVertical(lines_[line], l, AngleRange(edge, candidate_edge_[c]),
+                                          options_.gate_sigmas)) {
+            continue;
+          }
+          out[c] = MeetsVertical(*cuts_[c], region) ? 1 : 0;
+        } else {
+          out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
+        }
+      }
+    }
+  }
+
+  // True when every leaf below would have most of its pairs fitting a verified pose and fewer
+  // lines than it explains (the visitor skips those: they would be verified into it again).
+  // Basins the visitor added since the last node are indexed here first.
+  bool VerifiedAgain(int open_lines) {
+    if (basins_ == nullptr) return false;
+    while (basin_flags_.size() < basins_->size()) {
+      const VerifiedBasin& basin = (*basins_)[basin_flags_.size()];
+      std::vector<char> flags(candidate_edge_.size(), 0);
+      for (size_t c = 0; c < flags.size(); ++c) {
+        flags[c] = std::binary_search(basin.fitting.begin(), basin.fitting.end(),
+                                      std::make_pair(candidate_edge_[c], candidate_line_[c]));
+      }
+      int fit = 0;
+      for (const auto& [e, l] : assigned_)
+        fit += flags[decided_[l]];
+      basin_flags_.push_back(std::move(flags));
+      basin_fit_.push_back(fit);
+    }
+    const int most = static_cast<int>(assigned_.size()) + open_lines;
+    for (size_t b = 0; b < basin_fit_.size(); ++b) {
+      if (most < (*basins_)[b].lines && 2 * basin_fit_[b] > most) return true;
+    }
+    return false;
+  }
+
+  // True when the region lies in the basin of a verified pose: its leaves are the same answer.
+  bool InBasin(const FeasibleRegion& region) const {
+    if (basins_ == nullptr) return false;
+    return std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
+      return region.Within(b.pose, b.radius_m, b.heading_rad);
+    });
+  }
+
+  void VisitLeaf(const std::vector<char>& alive, const FeasibleRegion& region) {
+    if (!IsMaximal(alive, region)) return;
+    // A leaf consistent with a verified pose would be verified into it again.
+    if (basins_ != nullptr &&
+        std::any_of(basins_->begin(), basins_->end(),
+                    [&](const VerifiedBasin& b) { return region.Contains(b.pose); })) {
+      return;
+    }
+    Hypothesis leaf{assigned_, region, assigned_caps_};
+    std::vector<std::pair<int, int>> key = leaf.pairs;
+    std::sort(key.begin(), key.end());
+    if (!visited_.insert(std::move(key)).second) return;
+    ++stats_->leaves;
+    visitor_bound_ = std::max(visitor_bound_, visit_(leaf));
   }
 
   // Inscribed-angle range of two vertical edges over the prior disk, computed once per pair.
@@ -159,38 +308,6 @@ class TreeSearch {
           InscribedAngleRange(edges_[edge1].foot, edges_[edge2].foot, prior_.centre, prior_.radius);
     }
     return *angle_ranges_[key];
-  }
-
-  // Upper bound on the levels from `depth` on that can still be matched: those with an unused
-  // candidate whose unary heading interval meets the region's headings, and no more than the
-  // distinct lines among those candidates (each line matches one edge).
-  int Reachable(size_t depth, const FeasibleRegion& region) const {
-    if (region.Empty()) return 0;
-    const HeadingInterval h = region.Heading();
-    int levels = 0, vertical_levels = 0;
-    std::fill(reachable_lines_.begin(), reachable_lines_.end(), false);
-    int lines = 0;
-    for (size_t d = depth; d < levels_.size(); ++d) {
-      const Level& level = levels_[d];
-      const bool vertical = edges_[level.edge].vertical;
-      if (vertical && VerticalsFull()) continue;
-      bool any = false;
-      for (size_t c = 0; c < level.lines.size(); ++c) {
-        const int line = level.lines[c];
-        if (used_[line] || level.headings[c].lo > h.hi || level.headings[c].hi < h.lo) continue;
-        any = true;
-        if (!reachable_lines_[line]) {
-          reachable_lines_[line] = true;
-          ++lines;
-        }
-      }
-      if (any) (vertical ? vertical_levels : levels) += 1;
-    }
-    if (options_.max_vertical_matches > 0) {
-      vertical_levels =
-          std::min(vertical_levels, options_.max_vertical_matches - assigned_verticals_);
-    }
-    return std::min(levels + vertical_levels, lines);
   }
 
   // True when the extension keeps most of the region (at least half of its heading bins and a
@@ -213,17 +330,15 @@ class TreeSearch {
     return true;
   }
 
-  // A leaf is kept only when no skipped edge could have been matched as well in every pose
-  // cluster: every subset of a consistent assignment is consistent, and verifying those again
-  // would be wasted work.
-  bool IsMaximal(const FeasibleRegion& region) const {
-    for (int depth : skipped_) {
-      const Level& level = levels_[depth];
-      if (edges_[level.edge].vertical && VerticalsFull()) continue;
-      for (int line : level.lines) {
-        if (used_[line]) continue;
-        if (Extend(level.edge, line, region, &maximal_scratch_) &&
-            KeepsEveryCluster(region, maximal_scratch_)) {
+  // A leaf is kept only when no line left as clutter could have been assigned as well in every
+  // pose cluster: every subset of a consistent assignment is consistent, and verifying those
+  // again would be wasted work.
+  bool IsMaximal(const std::vector<char>& alive, const FeasibleRegion& region) const {
+    for (size_t j = 0; j < lines_.size(); ++j) {
+      if (decided_[j] != kClutter) continue;
+      for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
+        if (!alive[c] || OverlapsAssigned(candidate_edge_[c], static_cast<int>(j))) continue;
+        if (Extend(c, region, &maximal_scratch_) && KeepsEveryCluster(region, maximal_scratch_)) {
           return false;
         }
       }
@@ -237,17 +352,28 @@ class TreeSearch {
   const InterpretationTreeOptions& options_;
   const LeafVisitor& visit_;
   InterpretationTreeStats* stats_;
-  int min_matches_;
+  const std::vector<VerifiedBasin>* basins_;
   Gate gate_;
-  std::vector<Level> levels_;
-  std::vector<int> suffix_;  // levels remaining from each depth
-  std::vector<bool> used_;
-  mutable std::vector<bool> reachable_lines_;  // scratch of Reachable()
-  std::vector<FeasibleRegion> regions_;        // per depth
+  std::vector<double> caps_;
+  std::vector<int> order_;  // lines by decreasing cap
+  // Candidates by line: line j holds [line_offsets_[j], line_offsets_[j + 1]).
+  std::vector<int> line_offsets_, candidate_edge_, candidate_line_;
+  std::vector<std::optional<VerticalCut>> cuts_;  // vertical candidates' cuts
+  // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
+  std::vector<std::vector<char>> alive_;
+  std::vector<int> decided_;     // per line: assigned candidate, kUndecided or kClutter
+  std::vector<int> edge_lines_;  // per edge: lines assigned on the current branch
+  int distinct_edges_ = 0;
+  std::vector<FeasibleRegion> regions_;  // per depth
   mutable FeasibleRegion maximal_scratch_;
   std::vector<std::pair<int, int>> assigned_;
-  int assigned_verticals_ = 0;
-  std::vector<int> skipped_;
+  double assigned_caps_ = 0.0;
+  double pass_bound_ = 0.0;
+  double visitor_bound_ = 0.0;
+  std::set<std::vector<std::pair<int, int>>> visited_;
+  // Per basin: which candidates fit its pose, and how many assigned pairs do.
+  std::vector<std::vector<char>> basin_flags_;
+  std::vector<int> basin_fit_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };
 
@@ -255,8 +381,12 @@ class TreeSearch {
 
 bool InterpretationTreeOptions::Check(std::string* why) const {
   if (!(gate_sigmas > 0.0) || min_matches < 2 || max_nodes < 1 || max_hypotheses < 1 ||
-      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1) {
-    *why = "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1";
+      !(heading_bin_deg > 0.0) || !(extent_slack_px >= 0.0) || max_bins < 1 ||
+      !(deepening_lines > 0.0) || !(deepening_fraction >= 0.0 && deepening_fraction < 1.0) ||
+      max_lines < 2 || max_checks < 1) {
+    *why =
+        "interpretation tree: gate_sigmas > 0, min_matches >= 2, budgets >= 1, "
+        "deepening_lines > 0, deepening_fraction in [0, 1), max_lines >= 2";
     return false;
   }
   return true;
@@ -264,10 +394,12 @@ bool InterpretationTreeOptions::Check(std::string* why) const {
 
 void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
                               const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats) {
+                              const InterpretationTreeOptions& options,
+                              const std::vector<double>& line_caps, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats,
+                              const std::vector<VerifiedBasin>* basins) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, visit, stats).Run();
+  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Run();
 }
 
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
@@ -277,10 +409,10 @@ std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            InterpretationTreeStats* stats) {
   std::vector<Hypothesis> leaves;
   SearchInterpretationTree(
-      edges, lines, prior, options,
+      edges, lines, prior, options, {},
       [&](const Hypothesis& h) {
         leaves.push_back(h);
-        return 0;
+        return 0.0;
       },
       stats);
   return leaves;

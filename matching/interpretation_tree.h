@@ -2,7 +2,16 @@
 // et al. 2005, section 3.2). Non-vertical edges are paired with all image lines under the unary
 // constraint, vertical edges with the vertical-candidate lines under the unary wedge and the
 // binary inscribed-angle constraints; along each branch the correspondences must share a common
-// pose (FeasibleRegion). Leaves are maximal consistent assignments of at least k edges.
+// pose (FeasibleRegion). The tree is searched line by line: each line takes a candidate edge or
+// none (clutter), an edge may take several collinear non-overlapping lines (fragments). Leaves
+// are maximal consistent assignments of at least k edges.
+//
+// The search is a branch and bound on the evidence a leaf could reach: every line has a cap (the
+// largest log-likelihood ratio it can contribute), a node's bound is the caps of its assigned
+// lines plus those of the undecided lines with a candidate still consistent (forward checking),
+// and nodes below the visitor's current bound are cut. Passes with a decreasing bound (iterative
+// deepening) find the leaves that explain the most lines first, so the bound is tight early.
+// docs/matching.md has the details.
 #pragma once
 
 #include <functional>
@@ -21,10 +30,17 @@ struct InterpretationTreeOptions {
   double heading_bin_deg = 0.75;      // finest heading bins of the feasible region (degrees)
   int max_bins = 96;                  // bins are split finer as the headings narrow, up to this
   int min_matches = 4;                // k: leaves with fewer correspondences are discarded
-  int max_vertical_matches = 0;       // vertical correspondences per hypothesis (0: no limit)
-  int bound_slack = 2;        // branch and bound: leaves smaller than best - slack are pruned
-  int max_nodes = 200000;     // search budget (deterministic)
-  int max_hypotheses = 1000;  // leaves kept at most
+  // Lines assigned to one edge are fragments: they may not overlap (beyond extent_slack_px) and
+  // must lie on one line (FragmentChiSquare with this offset noise, pixels, below 13.8).
+  double fragment_offset_px = 1.0;
+  // Iterative deepening: each pass lowers the bound by this many lines' worth of caps, or by
+  // this fraction of it when that is more (many lines).
+  double deepening_lines = 2.0;
+  double deepening_fraction = 0.4;
+  int max_lines = 100;       // lines entering the tree at most: those with the largest caps
+  int max_nodes = 5000;      // search budget (deterministic), over all passes
+  int max_hypotheses = 200;  // leaves handed to the visitor at most
+  int max_checks = 100000;   // forward-checking tests at most (the work of the nodes)
 
   bool Check(std::string* why) const;
 };
@@ -36,6 +52,9 @@ struct PriorRegion {
   HeadingInterval heading;
   double height = 0.0;
   double focal_px = 1000.0;  // mean focal length of the camera (pixels)
+  // When set, camera positions lie in this box (the navigable area's bounds).
+  bool has_bounds = false;
+  Eigen::Vector2d bounds_min = Eigen::Vector2d::Zero(), bounds_max = Eigen::Vector2d::Zero();
 };
 
 // A leaf: (edge index, line index) pairs into the given edge and line lists, and the pose region
@@ -43,28 +62,49 @@ struct PriorRegion {
 struct Hypothesis {
   std::vector<std::pair<int, int>> pairs;
   FeasibleRegion region;
+  // Sum of the caps of the leaf's lines: the most evidence its pose could gather from the
+  // tree's view (maximal: no other line fits its region).
+  double bound = 0.0;
+};
+
+// A pose already verified and what would be verified into it again: subtrees whose region lies
+// in its neighbourhood (radius_m, heading_rad), leaves whose region holds the pose, and subtrees
+// all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
+// pose) and fewer lines than it explains.
+struct VerifiedBasin {
+  Pose3Dof pose;
+  double radius_m = 0.0;
+  double heading_rad = 0.0;
+  int lines = 0;                             // lines the verified pose explains
+  std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
 };
 
 struct InterpretationTreeStats {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int nodes = 0;             // tree nodes expanded
-  int leaves = 0;            // leaves visited
+  int checks = 0;            // forward-checking tests of candidates against regions
+  int leaves = 0;            // leaves handed to the visitor
+  int passes = 0;            // iterative-deepening passes
   bool budget_exhausted = false;
 };
 
-// Called on every leaf in search order. Returns the smallest leaf size still worth exploring
-// (branch and bound: once a hypothesis is verified with m edges, branches that cannot reach about
-// m are pruned); return 0 to keep options.min_matches.
-using LeafVisitor = std::function<int(const Hypothesis&)>;
+// Called on leaves in search order, each distinct leaf once, when its bound reaches the current
+// one. Returns the smallest bound still worth exploring (the best evidence found less the
+// ambiguity margin); return 0 to keep the current one.
+using LeafVisitor = std::function<double(const Hypothesis&)>;
 
-// Searches the tree depth first, assignments before skips. Deterministic: the same input gives
+// Searches the tree depth first, assignments (longest lines first) before skips. `line_caps`
+// holds each line's cap (nats); empty means 1 per line (bounds count lines). `basins` (may be
+// null; the visitor may add to it) are read at every node. Deterministic: the same input gives
 // the same leaves in the same order.
 void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
                               const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats);
+                              const InterpretationTreeOptions& options,
+                              const std::vector<double>& line_caps, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats,
+                              const std::vector<VerifiedBasin>* basins = nullptr);
 
-// All leaves (no bound beyond options.min_matches).
+// All leaves with at least options.min_matches correspondences (no bound).
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            const std::vector<ObservedLine>& lines,
                                            const PriorRegion& prior,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 
@@ -51,8 +52,8 @@ Localizer::Localizer(const WireframeModel& model, const ViewInvariantRegions* re
   // The focal scale is estimated with the pose, with the calibration error as its prior.
   if (options_.verification.refinement.focal_prior_sigma == 0.0) {
     options_.verification.refinement.focal_prior_sigma = options_.noise.focal_relative;
-    options_.verification.refinement.prior_pixel_sigma = std::max(options_.noise.offset_px, 0.5);
   }
+  options_.tree.fragment_offset_px = options_.noise.fragment_offset_px;
   std::string why;
   if (!options_.Check(&why)) throw InputError("localizer options: " + why);
   if (!camera_.Check(&why)) throw InputError("camera: " + why);
@@ -91,43 +92,88 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
                    problem.prior.heading + problem.delta_phi};
   prior.height = problem.height;
   prior.focal_px = 0.5 * (camera_.px + camera_.py);
-  VerificationContext context{&edges,         &lines,       &camera_,
-                              problem.height, problem.tilt, &occlusion_,
-                              &prior,         area_,        options_.noise.focal_relative};
+  if (area_ != nullptr) {
+    prior.has_bounds = true;
+    prior.bounds_min = area_->BoundsMin();
+    prior.bounds_max = area_->BoundsMax();
+  }
+  VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
+                              &occlusion_, &prior, area_,    options_.noise};
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
     // Leaves are verified as the search finds them: the pose of the leaf's correspondences
-    // first (Levenberg-Marquardt), then guided matching from it -- unless that pose is within
-    // the duplicate tolerance of a leaf pose already verified, which would converge the same way.
-    // Branch and bound: once a leaf of m correspondences verifies plausibly, leaves smaller than
-    // m - bound_slack are pruned (the truth's leaf holds nearly all the edges the tree assigns).
+    // (Levenberg-Marquardt, trimmed to consistency), then guided matching and the evidence.
+    // Branch and bound: leaves and nodes whose bound (the caps of the lines they could explain)
+    // cannot come within the ambiguity margin of the best evidence found are cut; a leaf whose
+    // pairs all belong to a pose already verified would converge to it and is skipped.
     InterpretationTreeStats stats;
-    int best_leaf = 0;
-    std::vector<Pose3Dof> leaf_poses;  // LM poses of the leaves verified in full
     const VerificationOptions& vo = options_.verification;
+    const LineFitModel fit_model = FitModel(context, vo);
+    std::vector<double> caps;
+    for (const ObservedLine& line : lines)
+      caps.push_back(vo.cap_efficiency *
+                     (MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density));
+    double best = -std::numeric_limits<double>::infinity();
+    std::vector<std::vector<std::pair<int, int>>> verified_pairs;
+    std::vector<VerifiedBasin> basins;
+    long pair_tests = 0;
+    context.pair_tests = &pair_tests;
     SearchInterpretationTree(
-        edges, lines, prior, options_.tree,
+        edges, lines, prior, options_.tree, caps,
         [&](const Hypothesis& h) {
-          ++result.hypotheses;
-          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
-          for (const Pose3Dof& seen : leaf_poses) {
-            if (std::hypot(seen.x - leaf.pose.x, seen.y - leaf.pose.y) < vo.duplicate_distance_m &&
-                std::abs(WrapAngle(seen.heading - leaf.pose.heading)) <
-                    DegToRad(vo.duplicate_heading_deg)) {
-              return best_leaf - options_.tree.bound_slack;
+          const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
+          for (const auto& pairs : verified_pairs) {
+            if (std::all_of(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+                  return std::binary_search(pairs.begin(), pairs.end(), p);
+                })) {
+              return bound;
             }
           }
-          leaf_poses.push_back(leaf.pose);
-          verified.push_back(Rematch(context, leaf, vo));
-          if (verified.back().plausible) {
-            best_leaf = std::max(best_leaf, static_cast<int>(h.pairs.size()));
+          // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
+          // explains as many: verified into it again.
+          for (const VerifiedBasin& b : basins) {
+            const int fit =
+                static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+                  return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
+                }));
+            const int size = static_cast<int>(h.pairs.size());
+            if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
+              return bound;
+            }
           }
-          return best_leaf - options_.tree.bound_slack;
+          if (pair_tests >= vo.max_pair_tests) {
+            result.budget_exhausted = true;
+            return std::numeric_limits<double>::infinity();  // stops the search
+          }
+          ++result.hypotheses;
+          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
+          if (!TrimHypothesis(context, vo, &leaf) ||
+              HypothesisEvidence(context, vo, leaf) < bound) {
+            return bound;
+          }
+          VerifiedPose v = Rematch(context, leaf, vo);
+          if (v.plausible) {
+            CompleteEvidence(context, vo, &v);
+            best = std::max(best, v.evidence.Score());
+            // Leaves that would be verified into this pose again are not verified: those whose
+            // region holds it or lies within basin_sigmas of its standard deviations, and those
+            // most of whose pairs fit it.
+            basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
+                              vo.basin_sigmas * v.refinement.heading_sigma_rad,
+                              static_cast<int>(v.pairs.size()), FittingPairs(context, vo, v)});
+          }
+          std::vector<std::pair<int, int>> pairs = v.pairs;
+          std::sort(pairs.begin(), pairs.end());
+          verified_pairs.push_back(std::move(pairs));
+          verified.push_back(std::move(v));
+          return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
         },
-        &stats);
+        &stats, &basins);
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
-    result.budget_exhausted = stats.budget_exhausted;
+    result.tree_checks = stats.checks;
+    result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
+    context.pair_tests = nullptr;
   } else {
     BaselineStats stats;
     verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);
@@ -143,73 +189,50 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
 void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
                        const std::vector<MatchEdge>& edges, LocalizationResult* out) const {
   LocalizationResult& result = *out;
+  const VerificationOptions& vo = options_.verification;
   if (verified.empty()) {
     result.reason = "no consistent hypothesis";
     return;
   }
-  // Finalists: the plausible hypotheses, best first by matched edges, each distinct set of
-  // correspondences once; all are scored by their evidence (with occlusion).
-  std::sort(verified.begin(), verified.end(), BetterThan);
-  const VerificationOptions& vo = options_.verification;
-  std::vector<const VerifiedPose*> finalists;
-  std::set<std::vector<std::pair<int, int>>> seen;
-  for (const VerifiedPose& v : verified) {
-    if (!v.plausible || static_cast<int>(finalists.size()) >= vo.finalists) break;
-    std::vector<std::pair<int, int>> key = v.pairs;
-    std::sort(key.begin(), key.end());
-    if (seen.insert(std::move(key)).second) finalists.push_back(&v);
+  for (VerifiedPose& v : verified) {
+    if (v.plausible) CompleteEvidence(context, vo, &v);
   }
-  if (finalists.empty()) {
-    const VerifiedPose& best = verified.front();
-    result.reason = "no plausible pose (best: " + std::to_string(best.matched_edges) +
-                    " edges, rms " + std::to_string(best.refinement.rms_px) + " px)";
+  std::stable_sort(verified.begin(), verified.end(), BetterThan);
+  const VerifiedPose& best = verified.front();
+  if (!best.plausible) {
+    result.reason = "no plausible pose (best: " + best.implausible_because + ")";
     return;
   }
-  std::vector<PoseEvidence> evidence;
-  for (const VerifiedPose* f : finalists) {
-    evidence.push_back(Evidence(context, model_, occlusion_, *f, vo));
-  }
-  size_t chosen = 0;
-  for (size_t i = 1; i < finalists.size(); ++i) {
-    if (evidence[i].Score() > evidence[chosen].Score()) chosen = i;
-  }
-  const VerifiedPose& chosen_pose = *finalists[chosen];
-  // The correspondences reported are matched afresh at the chosen pose, so that hypotheses
-  // converging to the same pose report the same matches.
-  VerifiedPose rematched = Rematch(context, chosen_pose, vo);
-  const VerifiedPose& best = rematched.plausible ? rematched : chosen_pose;
-  auto distinct = [&](const Pose3Dof& a, const Pose3Dof& b) {
-    return std::hypot(a.x - b.x, a.y - b.y) > vo.ambiguity_distance_m ||
-           std::abs(WrapAngle(a.heading - b.heading)) > DegToRad(vo.ambiguity_heading_deg);
+  // Finalists: the best pose, then the best of each distinct other pose (diagnostics).
+  auto finalist = [&](const VerifiedPose& v) {
+    Finalist f{v.pose, v.matched_edges, v.mean_distance_px, v.evidence, {}};
+    for (const auto& [e, l] : v.pairs)
+      f.matches.emplace_back(edges[e].edge_id, l);
+    return f;
   };
-  for (size_t i = 0; i < finalists.size(); ++i) {
-    if (i == chosen || !distinct(finalists[i]->pose, best.pose)) continue;
-    Finalist f{finalists[i]->pose,
-               finalists[i]->matched_edges,
-               finalists[i]->mean_distance_px,
-               evidence[i],
-               {}};
-    for (const auto& [e, l] : finalists[i]->pairs)
-      f.matches.emplace_back(edges[e].edge_id, l);
-    result.finalists.push_back(std::move(f));
+  result.finalists.push_back(finalist(best));
+  std::vector<Pose3Dof> distinct = {best.pose};
+  for (const VerifiedPose& v : verified) {
+    if (!v.plausible) break;
+    if (std::any_of(distinct.begin(), distinct.end(),
+                    [&](const Pose3Dof& d) { return SamePose(d, v.pose, vo); })) {
+      continue;
+    }
+    distinct.push_back(v.pose);
+    result.finalists.push_back(finalist(v));
   }
-  std::sort(
-      result.finalists.begin(), result.finalists.end(),
-      [](const Finalist& a, const Finalist& b) { return a.evidence.Score() > b.evidence.Score(); });
-  {
-    Finalist f{best.pose, best.matched_edges, best.mean_distance_px, evidence[chosen], {}};
-    for (const auto& [e, l] : best.pairs)
-      f.matches.emplace_back(edges[e].edge_id, l);
-    result.finalists.insert(result.finalists.begin(), std::move(f));
-  }
+  result.support = best.evidence.Support();
+  result.score_px = best.score_px;
+  const double score = best.evidence.Score();
   if (result.finalists.size() > 1 &&
-      result.finalists[1].evidence.Score() >= vo.ambiguity_ratio * evidence[chosen].Score()) {
+      score - result.finalists[1].evidence.Score() < vo.ambiguity_nats) {
     result.reason = "ambiguous: another pose explains the image almost as well";
     return;
   }
-  result.support = evidence[chosen].Support();
-  if (result.support < vo.min_support) {
-    result.reason = "low support " + std::to_string(result.support);
+  const double required = RequiredEvidence(context, vo, best);
+  if (score < required) {
+    result.reason =
+        "weak evidence (" + std::to_string(score) + " of " + std::to_string(required) + " nats)";
     return;
   }
   std::set<int> confident_edges;
@@ -223,7 +246,6 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.found = true;
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
-  result.score_px = best.score_px;
   for (const auto& [e, l] : best.confident_pairs)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());

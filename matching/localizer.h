@@ -68,8 +68,9 @@ struct LocalizationResult {
   int candidate_edges = 0;   // edges kept by the view-invariant regions
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int tree_nodes = 0;
-  int hypotheses = 0;  // hypotheses verified (pose evaluations)
-  int samples = 0;     // baseline only: random pairs drawn
+  int tree_checks = 0;  // forward-checking tests of the tree search
+  int hypotheses = 0;   // hypotheses verified (pose evaluations)
+  int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
   std::string reason;               // why no pose was accepted (empty when found)
   std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first
@@ -92,6 +93,9 @@ class Localizer {
 
   const CameraIntrinsics& camera() const { return camera_; }
   const LocalizerOptions& options() const { return options_; }
+  const WireframeModel& model() const { return model_; }
+  const NavigableArea* area() const { return area_; }
+  const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
   // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity

@@ -8,12 +8,20 @@
 namespace linetrack {
 
 bool LineNoise::Check(std::string* why) const {
-  const double values[] = {offset_px, angle_deg, focal_relative, tilt_deg};
+  const double values[] = {offset_px, angle_deg, focal_relative, tilt_deg, fragment_offset_px};
   for (double v : values) {
     if (!std::isfinite(v) || v < 0.0) {
       *why = "line noise values must be finite and >= 0";
       return false;
     }
+  }
+  if (!(vertical_clutter_fraction >= 0.0 && vertical_clutter_fraction < 1.0) ||
+      !(detection_probability > 0.0 && detection_probability < 1.0) ||
+      !(clutter_share > 0.0 && clutter_share <= 1.0)) {
+    *why =
+        "line noise: vertical_clutter_fraction in [0, 1), detection_probability in (0, 1), "
+        "clutter_share in (0, 1]";
+    return false;
   }
   if (offset_px + angle_deg == 0.0) {
     *why = "line noise: offset_px or angle_deg must be positive";
@@ -91,6 +99,12 @@ std::vector<ObservedLine> PrepareLines(const std::vector<Segment2>& lines,
     const double ny = line.normal.y();
     const double sigma_ny = std::sqrt(std::max(line.normal_cov(1, 1), 1e-18));
     line.maybe_vertical = std::abs(ny) <= gate_sigmas * sigma_ny;
+    const double f = noise.vertical_clutter_fraction, z = ny / sigma_ny;
+    line.clutter_log_density =
+        std::log((1.0 - f) + f * kPi / (std::sqrt(2.0 * kPi) * std::max(sigma_angle, 1e-6)) *
+                                 std::exp(-0.5 * z * z)) +
+        std::log(std::max(noise.clutter_share * static_cast<double>(lines.size()), 1.0) /
+                 noise.detection_probability);
     const double nx = line.normal.x(), nz = line.normal.z();
     const double horizontal2 = nx * nx + nz * nz;
     Eigen::Vector2d bearing_dir(nz, -nx);  // (x, z) of the plane's horizontal direction

@@ -20,53 +20,85 @@ bool PoseRefinementOptions::Check(std::string* why) const {
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
                                   double height, double tilt, const Pose3Dof& pose,
                                   Eigen::Matrix<double, 2, 3>* jacobian) {
+  if (jacobian == nullptr)
+    return EndpointResiduals(match, camera, height, tilt, pose, 1.0, nullptr);
+  Eigen::Matrix<double, 2, 4> j4;
+  const Eigen::Vector2d r = EndpointResiduals(match, camera, height, tilt, pose, 1.0, &j4);
+  *jacobian = j4.leftCols<3>();
+  return r;
+}
+
+PoseView ViewOf(const Pose3Dof& pose, double height, double tilt) {
   const Eigen::Matrix3d cam_from_level = LevelFromCam(tilt).transpose();
   const double ch = std::cos(pose.heading), sh = std::sin(pose.heading);
   Eigen::Matrix3d level_from_world, d_level_from_world;
   level_from_world << sh, -ch, 0.0, 0.0, 0.0, -1.0, ch, sh, 0.0;
   d_level_from_world << ch, sh, 0.0, 0.0, 0.0, 0.0, -sh, ch, 0.0;
-  const Eigen::Matrix3d rotation = cam_from_level * level_from_world;
-  const Eigen::Vector3d centre(pose.x, pose.y, height);
-  const Eigen::Vector3d xa = rotation * (match.edge_a - centre);
-  const Eigen::Vector3d xb = rotation * (match.edge_b - centre);
-  // Line through the two projections in normalised coordinates, then in pixels: l_p = K^-T l_n.
+  return {cam_from_level * level_from_world, cam_from_level * d_level_from_world,
+          Eigen::Vector3d(pose.x, pose.y, height)};
+}
+
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, double height, double tilt,
+                                  const Pose3Dof& pose, double scale,
+                                  Eigen::Matrix<double, 3, 4>* derivative) {
+  return ProjectedEdgeLine(a, b, camera, ViewOf(pose, height, tilt), scale, derivative);
+}
+
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, const PoseView& view,
+                                  double scale, Eigen::Matrix<double, 3, 4>* derivative) {
+  const Eigen::Vector3d xa = view.rotation * (a - view.centre);
+  const Eigen::Vector3d xb = view.rotation * (b - view.centre);
+  // Line through the two projections in normalised coordinates, then in pixels: l_p = K^-T l_n,
+  // K with focal lengths s px, s py; then scaled to a unit normal.
   const Eigen::Vector3d ln = xa.cross(xb);
+  const double fx = scale * camera.px, fy = scale * camera.py;
   auto to_pixels = [&](const Eigen::Vector3d& l) {
-    return Eigen::Vector3d(l.x() / camera.px, l.y() / camera.py,
-                           l.z() - l.x() * camera.u0 / camera.px - l.y() * camera.v0 / camera.py);
+    return Eigen::Vector3d(l.x() / fx, l.y() / fy,
+                           l.z() - l.x() * camera.u0 / fx - l.y() * camera.v0 / fy);
   };
   const Eigen::Vector3d lp = to_pixels(ln);
-  const double norm = std::hypot(lp.x(), lp.y());
+  const double norm = std::sqrt(lp.x() * lp.x() + lp.y() * lp.y());
+  const Eigen::Vector3d line = lp / norm;
+  if (derivative) {
+    // d (lp / |lp_uv|) = (dlp - line (line_uv . dlp_uv)) / |lp_uv|.
+    auto column = [&](const Eigen::Vector3d& dlp, int k) {
+      derivative->col(k) = (dlp - line * (line.x() * dlp.x() + line.y() * dlp.y())) / norm;
+    };
+    column(to_pixels((view.d_rotation * (a - view.centre)).cross(xb) +
+                     xa.cross(view.d_rotation * (b - view.centre))),
+           0);
+    for (int k = 1; k <= 2; ++k) {  // d x_a / dx = d x_b / dx = -rotation.col(0); y likewise
+      const Eigen::Vector3d d = -view.rotation.col(k - 1);
+      column(to_pixels(d.cross(xb) + xa.cross(d)), k);
+    }
+    // lp(s) = (p / s, q / s, l_z - (p u0 + q v0) / s): d lp / ds = -(lp - (0, 0, l_z)) / s.
+    column(-(lp - Eigen::Vector3d(0.0, 0.0, ln.z())) / scale, 3);
+  }
+  return line;
+}
+
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  double height, double tilt, const Pose3Dof& pose, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian) {
+  return EndpointResiduals(match, camera, ViewOf(pose, height, tilt), scale, jacobian);
+}
+
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  const PoseView& view, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian) {
+  Eigen::Matrix<double, 3, 4> d;
+  const Eigen::Vector3d line =
+      ProjectedEdgeLine(match.edge_a, match.edge_b, camera, view, scale, jacobian ? &d : nullptr);
   const Eigen::Vector3d qa(match.observed.a.x(), match.observed.a.y(), 1.0);
   const Eigen::Vector3d qb(match.observed.b.x(), match.observed.b.y(), 1.0);
-  const Eigen::Vector2d r(lp.dot(qa) / norm, lp.dot(qb) / norm);
   if (jacobian) {
-    Eigen::Matrix3d dxa, dxb;  // columns: d/dh, d/dx, d/dy
-    const Eigen::Matrix3d d_rotation = cam_from_level * d_level_from_world;
-    dxa.col(0) = d_rotation * (match.edge_a - centre);
-    dxb.col(0) = d_rotation * (match.edge_b - centre);
-    dxa.col(1) = dxb.col(1) = -rotation.col(0);
-    dxa.col(2) = dxb.col(2) = -rotation.col(1);
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d dlp = to_pixels(dxa.col(k).cross(xb) + xa.cross(dxb.col(k)));
-      const double dnorm = (lp.x() * dlp.x() + lp.y() * dlp.y()) / norm;
-      (*jacobian)(0, k) = (dlp.dot(qa) * norm - lp.dot(qa) * dnorm) / (norm * norm);
-      (*jacobian)(1, k) = (dlp.dot(qb) * norm - lp.dot(qb) * dnorm) / (norm * norm);
-    }
+    jacobian->row(0) = qa.transpose() * d;
+    jacobian->row(1) = qb.transpose() * d;
   }
-  return r;
+  return {line.dot(qa), line.dot(qb)};
 }
-
-namespace {
-
-CameraIntrinsics Scaled(const CameraIntrinsics& camera, double scale) {
-  CameraIntrinsics c = camera;
-  c.px *= scale;
-  c.py *= scale;
-  return c;
-}
-
-}  // namespace
 
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
@@ -83,13 +115,11 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
   result.focal_scale = start_scale;
   if (matches.empty()) return result;
   const int n = static_cast<int>(matches.size());
-  // Parameters: (heading, x, y) and, with enough lines and a prior, the focal scale s, which
-  // absorbs a calibration error (MAP with s ~ N(1, focal_prior_sigma), the prior weighed as one
-  // residual of prior_pixel_sigma pixels).
+  // Parameters (heading, x, y) and, with enough lines, the focal scale s, which absorbs a
+  // calibration error: MAP with the prior s ~ N(1, focal_prior_sigma).
   const bool with_scale = options.focal_prior_sigma > 0.0 && n >= options.min_matches_for_scale;
   const int dof = with_scale ? 4 : 3;
-  const double prior_weight =
-      with_scale ? options.prior_pixel_sigma / options.focal_prior_sigma : 0.0;
+  const double prior_weight = with_scale ? 1.0 / options.focal_prior_sigma : 0.0;
   auto huber = [&](double r) {
     const double a = std::abs(r);
     return options.huber_px > 0.0 && a > options.huber_px
@@ -101,35 +131,32 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     return options.huber_px > 0.0 && a > options.huber_px ? options.huber_px / a : 1.0;
   };
   auto cost_at = [&](const Pose3Dof& pose, double scale) {
-    const CameraIntrinsics c = Scaled(camera, scale);
     double cost = 0.0;
+    const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
-      const Eigen::Vector2d r = EndpointResiduals(m, c, height, tilt, pose);
+      const Eigen::Vector2d r = m.whitening * EndpointResiduals(m, camera, view, scale, nullptr);
       cost += huber(r[0]) + huber(r[1]);
     }
     const double p = prior_weight * (scale - 1.0);
     return cost + p * p;
   };
-  // Normal equations at (pose, scale); the scale column by central differences.
+  // Normal equations at (pose, scale) on the whitened residuals; returns the raw sum of squared
+  // pixel residuals and (in *chi2) of the whitened ones.
   auto normal_equations = [&](const Pose3Dof& pose, double scale, bool robust, Eigen::Matrix4d* jtj,
-                              Eigen::Vector4d* jtr) {
+                              Eigen::Vector4d* jtr, double* chi2) {
     jtj->setZero();
     jtr->setZero();
-    const CameraIntrinsics c = Scaled(camera, scale);
-    const double h = 1e-6;
-    const CameraIntrinsics up = Scaled(camera, scale + h), down = Scaled(camera, scale - h);
     double squares = 0.0;
+    *chi2 = 0.0;
+    const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
-      Eigen::Matrix<double, 2, 3> j3;
-      const Eigen::Vector2d r = EndpointResiduals(m, c, height, tilt, pose, &j3);
-      squares += r.squaredNorm();
-      Eigen::Matrix<double, 2, 4> j = Eigen::Matrix<double, 2, 4>::Zero();
-      j.leftCols<3>() = j3;
-      if (with_scale) {
-        j.col(3) = (EndpointResiduals(m, up, height, tilt, pose) -
-                    EndpointResiduals(m, down, height, tilt, pose)) /
-                   (2.0 * h);
-      }
+      Eigen::Matrix<double, 2, 4> j;
+      const Eigen::Vector2d raw = EndpointResiduals(m, camera, view, scale, &j);
+      squares += raw.squaredNorm();
+      const Eigen::Vector2d r = m.whitening * raw;
+      *chi2 += r.squaredNorm();
+      j = m.whitening * j;
+      if (!with_scale) j.col(3).setZero();
       for (int k = 0; k < 2; ++k) {
         const double w = robust ? weight(r[k]) : 1.0;
         *jtj += w * j.row(k).transpose() * j.row(k);
@@ -147,9 +174,10 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
   double cost = cost_at(result.pose, result.focal_scale);
   Eigen::Matrix4d jtj;
   Eigen::Vector4d jtr;
+  double chi2 = 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
-    normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr);
+    normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2);
     bool improved = false;
     Eigen::Vector4d step = Eigen::Vector4d::Zero();
     for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
@@ -177,19 +205,23 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     }
   }
   result.pose.heading = WrapAngle(result.pose.heading);
-  const double squares = normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr);
+  const double squares =
+      normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr, &result.chi2);
   result.rms_px = std::sqrt(squares / (2.0 * n));
-  // Pose uncertainty for 1 pixel of noise (the scale, when estimated, is marginalised out).
+  // Pose uncertainty: the inverse of the information (the scale, when estimated, included).
   const Eigen::MatrixXd information = jtj.topLeftCorner(dof, dof);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(information);
   const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(dof, dof));
-  if (ldlt.info() == Eigen::Success && covariance.allFinite() && covariance(0, 0) >= 0.0) {
+  if (ldlt.info() == Eigen::Success && covariance.allFinite() && covariance(0, 0) >= 0.0 &&
+      covariance(1, 1) >= 0.0 && covariance(2, 2) >= 0.0) {
+    result.covariance.topLeftCorner(dof, dof) = covariance;
     result.heading_sigma_rad = std::sqrt(covariance(0, 0));
     const Eigen::Matrix2d position = covariance.block<2, 2>(1, 1);
     result.position_sigma_m = std::sqrt(std::max(
         0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position, Eigen::EigenvaluesOnly)
                  .eigenvalues()[1]));
   } else {
+    result.covariance.setConstant(std::numeric_limits<double>::infinity());
     result.heading_sigma_rad = result.position_sigma_m = std::numeric_limits<double>::infinity();
   }
   return result;

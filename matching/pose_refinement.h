@@ -15,22 +15,24 @@
 namespace linetrack {
 
 // One correspondence for the pose: a model edge (world, metres) and an observed segment
-// (undistorted pixels).
+// (undistorted pixels). `whitening` W maps the two endpoint residuals to independent unit
+// variables (W^T W is the inverse of their covariance, pixels^-2); the identity means
+// independent 1-pixel noise.
 struct LineMatch {
   Eigen::Vector3d edge_a, edge_b;
   Segment2 observed;
+  Eigen::Matrix2d whitening = Eigen::Matrix2d::Identity();
 };
 
 struct PoseRefinementOptions {
   int max_iterations = 15;
   double step_tolerance = 1e-7;  // stop when the update (rad, m) is below this
-  double huber_px = 3.0;         // Huber threshold on endpoint residuals (pixels); 0: plain LS
-  // Focal scale s (px, py times s) estimated with the pose when > 0: the prior std of s - 1
-  // (LineNoise::focal_relative), weighed like one residual of prior_pixel_sigma pixels; only with
-  // at least min_matches_for_scale correspondences.
+  double huber_px = 3.0;         // Huber threshold on whitened residuals; 0: plain least squares
+  // Focal scale s (px, py times s) estimated with the pose when > 0: MAP with the prior
+  // s ~ N(1, focal_prior_sigma) (LineNoise::focal_relative), with at least
+  // min_matches_for_scale correspondences.
   double focal_prior_sigma = 0.0;
-  double prior_pixel_sigma = 3.0;
-  int min_matches_for_scale = 5;
+  int min_matches_for_scale = 2;
 
   bool Check(std::string* why) const;
 };
@@ -38,14 +40,40 @@ struct PoseRefinementOptions {
 struct PoseRefinementResult {
   Pose3Dof pose;
   double focal_scale = 1.0;  // estimated scale of px, py (1 when not estimated)
-  double rms_px = 0.0;       // RMS endpoint residual at the end
+  double rms_px = 0.0;       // RMS endpoint residual at the end (pixels, not whitened)
+  double chi2 = 0.0;         // sum of the squared whitened residuals at the end
   int iterations = 0;
   bool converged = false;
-  // Standard deviations of the pose for 1 pixel of endpoint noise, from (J^T J)^-1: large
-  // values mean the correspondences do not pin the pose down (e.g. all lines parallel).
-  double position_sigma_m = 0.0;  // largest axis of the position uncertainty (metres)
+  // Covariance of (heading, x, y, focal scale) from the inverse of the Gauss-Newton information
+  // (whitened residuals and the scale prior); the scale row and column are zero when it is not
+  // estimated. With identity whitening it is the covariance for 1 pixel of endpoint noise.
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  // Derived from `covariance`: largest axis of the position uncertainty (metres) and the heading
+  // standard deviation; infinite when the correspondences do not pin the pose down.
+  double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
 };
+
+// The camera-from-world rotation of a robot pose, its derivative w.r.t. the heading and the
+// camera centre: computed once for many projections at one pose.
+struct PoseView {
+  Eigen::Matrix3d rotation;
+  Eigen::Matrix3d d_rotation;
+  Eigen::Vector3d centre;
+};
+PoseView ViewOf(const Pose3Dof& pose, double height, double tilt);
+
+// The image line of the model edge through a and b (world) seen from `pose` with the focal
+// lengths scaled by `scale`: (l_u, l_v, l_c) with l_u u + l_v v + l_c = 0 and l_u^2 + l_v^2 = 1
+// (pixels; the line through the projections of a and b). `derivative` (optional) gets
+// d line / d (heading, x, y, scale).
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, double height, double tilt,
+                                  const Pose3Dof& pose, double scale,
+                                  Eigen::Matrix<double, 3, 4>* derivative);
+Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const CameraIntrinsics& camera, const PoseView& view,
+                                  double scale, Eigen::Matrix<double, 3, 4>* derivative);
 
 // The two endpoint residuals (pixels, signed) of `match` at `pose`; `jacobian` (optional) gets
 // d residual / d (heading, x, y).
@@ -53,8 +81,17 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   double height, double tilt, const Pose3Dof& pose,
                                   Eigen::Matrix<double, 2, 3>* jacobian = nullptr);
 
-// Refines `start` by Levenberg-Marquardt on all endpoint residuals (Huber-weighted), with the
-// focal scale too when the options ask for it (starting from `start_scale`).
+// The same with the focal lengths scaled by `scale`; `jacobian` (optional) gets
+// d residual / d (heading, x, y, scale).
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  double height, double tilt, const Pose3Dof& pose, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian);
+Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
+                                  const PoseView& view, double scale,
+                                  Eigen::Matrix<double, 2, 4>* jacobian);
+
+// Refines `start` by Levenberg-Marquardt on all whitened endpoint residuals (Huber-weighted),
+// with the focal scale too when the options ask for it (starting from `start_scale`).
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options);

@@ -1,9 +1,9 @@
 #include "matching/verification.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <set>
 
 #include "matching/segment_distance.h"
@@ -16,23 +16,6 @@ RobotPose Full(const Pose3Dof& pose, const VerificationContext& context) {
   return {pose.x, pose.y, pose.heading, context.height, context.tilt};
 }
 
-// Angle (radians, in [0, pi/2]) between the directions of two segments.
-double AngleBetween(const Segment2& a, const Segment2& b) {
-  const Eigen::Vector2d da = (a.b - a.a).normalized(), db = (b.b - b.a).normalized();
-  return std::acos(std::min(1.0, std::abs(da.dot(db))));
-}
-
-std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
-                                     const std::vector<std::pair<int, int>>& pairs) {
-  std::vector<LineMatch> matches;
-  matches.reserve(pairs.size());
-  for (const auto& [e, l] : pairs) {
-    const MatchEdge& edge = (*context.edges)[e];
-    matches.push_back({edge.a, edge.b, (*context.lines)[l].pixels});
-  }
-  return matches;
-}
-
 // The camera with its focal lengths scaled by `scale` (the estimated calibration error).
 CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
   CameraIntrinsics c = camera;
@@ -41,38 +24,105 @@ CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
   return c;
 }
 
-// Projects every candidate edge at `pose` (frustum-clipped, no occlusion); empty segments for
-// edges out of view.
-std::vector<std::optional<Segment2>> ProjectEdges(const VerificationContext& context,
-                                                  const Pose3Dof& pose, double focal_scale) {
+// W with W^T W = covariance^-1 (the inverse of the Cholesky factor).
+Eigen::Matrix2d Whitening(const Eigen::Matrix2d& covariance) {
+  const Eigen::Matrix2d l = covariance.llt().matrixL();
+  return l.inverse();
+}
+
+// Pairs as LineMatches whitened by the noise model with levers from the segment's own middle
+// (the projection is not known yet).
+std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
+                                     const std::vector<std::pair<int, int>>& pairs) {
+  std::vector<LineMatch> matches;
+  matches.reserve(pairs.size());
+  const double sigma_theta = DegToRad(context.noise.angle_deg);
+  for (const auto& [e, l] : pairs) {
+    const MatchEdge& edge = (*context.edges)[e];
+    const ObservedLine& line = (*context.lines)[l];
+    const double half = 0.5 * line.length_px;
+    matches.push_back(
+        {edge.a, edge.b, line.pixels,
+         Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta))});
+  }
+  return matches;
+}
+
+// A candidate edge seen from the pose: its frustum-clipped image, the clipped world segment, and
+// its image line with the derivative w.r.t. (heading, x, y, scale).
+struct EdgeImage {
+  bool visible = false;
+  Segment2 image;
+  Segment3 world;
+  Eigen::Vector3d line;
+  Eigen::Matrix<double, 3, 4> d_line;
+  // d image.a / d (heading, x, y, scale) and the same for image.b.
+  Eigen::Matrix<double, 2, 4> d_start, d_end;
+
+  // Variances along the image of its two ends for the pose covariance `c`.
+  Eigen::Vector2d EndVariance(const Eigen::Matrix4d& c) const {
+    const Eigen::Vector2d u = (image.b - image.a).normalized();
+    const Eigen::Vector4d ja = d_start.transpose() * u, jb = d_end.transpose() * u;
+    return {ja.dot(c * ja), jb.dot(c * jb)};
+  }
+};
+
+// d pixel(p) / d (heading, x, y, scale) for the world point p: with X = R (p - C) and
+// u = u0 + s px X_x / X_z, v = v0 + s py X_y / X_z.
+Eigen::Matrix<double, 2, 4> ProjectionJacobian(const CameraIntrinsics& camera, const PoseView& view,
+                                               double scale, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d x = view.rotation * (p - view.centre);
+  Eigen::Matrix<double, 3, 3> dx;  // columns: d X / d heading, x, y
+  dx.col(0) = view.d_rotation * (p - view.centre);
+  dx.col(1) = -view.rotation.col(0);
+  dx.col(2) = -view.rotation.col(1);
+  const double fx = scale * camera.px, fy = scale * camera.py, z2 = x.z() * x.z();
+  Eigen::Matrix<double, 2, 4> j;
+  for (int k = 0; k < 3; ++k) {
+    j(0, k) = fx * (dx(0, k) * x.z() - x.x() * dx(2, k)) / z2;
+    j(1, k) = fy * (dx(1, k) * x.z() - x.y() * dx(2, k)) / z2;
+  }
+  j(0, 3) = camera.px * x.x() / x.z();
+  j(1, 3) = camera.py * x.y() / x.z();
+  return j;
+}
+
+std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
+                                    double focal_scale) {
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
-  std::vector<std::optional<Segment2>> out;
-  out.reserve(context.edges->size());
-  for (const MatchEdge& edge : *context.edges) {
-    Segment3 s{edge.a, edge.b};
-    if (!ClipToFrustum(cam_from_world, camera, 0.05, &s)) {
-      out.emplace_back();
-      continue;
-    }
-    out.push_back(
-        Segment2{camera.Project(cam_from_world * s.a), camera.Project(cam_from_world * s.b)});
+  const PoseView view = ViewOf(pose, context.height, context.tilt);
+  std::vector<EdgeImage> out(context.edges->size());
+  for (size_t e = 0; e < out.size(); ++e) {
+    const MatchEdge& edge = (*context.edges)[e];
+    EdgeImage& image = out[e];
+    image.world = {edge.a, edge.b};
+    if (!ClipToFrustum(cam_from_world, camera, 0.05, &image.world)) continue;
+    image.image = {camera.Project(cam_from_world * image.world.a),
+                   camera.Project(cam_from_world * image.world.b)};
+    if (image.image.Length() < 1e-6) continue;
+    image.visible = true;
+    image.line =
+        ProjectedEdgeLine(edge.a, edge.b, *context.camera, view, focal_scale, &image.d_line);
+    image.d_start = ProjectionJacobian(*context.camera, view, focal_scale, image.world.a);
+    image.d_end = ProjectionJacobian(*context.camera, view, focal_scale, image.world.b);
   }
   return out;
 }
 
 bool InsidePrior(const VerificationContext& context, const Pose3Dof& pose,
-                 const VerificationOptions& options) {
+                 const PoseRefinementResult& refinement, const VerificationOptions& options) {
   if (context.area != nullptr &&
       !context.area->InsideWalls({pose.x, pose.y}, options.wall_margin_m)) {
     return false;
   }
   if (context.prior == nullptr) return true;
   const PriorRegion& prior = *context.prior;
-  const double margin = DegToRad(options.prior_margin_deg);
+  const double k = options.prior_margin_sigmas;
+  const double margin = DegToRad(options.prior_margin_deg) + k * refinement.heading_sigma_rad;
   const double offset = std::abs(WrapAngle(pose.heading - prior.heading.Mid()));
   return std::hypot(pose.x - prior.centre.x(), pose.y - prior.centre.y()) <=
-             prior.radius + options.prior_margin_m &&
+             prior.radius + options.prior_margin_m + k * refinement.position_sigma_m &&
          offset <= 0.5 * prior.heading.Width() + margin;
 }
 
@@ -91,74 +141,176 @@ Eigen::Vector3d PointSeenOnEdge(const MatchEdge& edge, const Segment2& observed,
   return edge.a + t * d;
 }
 
-// A line near an edge: (edge index, line index) and its eq. 9 distance (pixels).
-struct Claim {
+// A line that fits an edge within the gates at the pose.
+struct Candidate {
   int edge = -1;
   int line = -1;
-  double distance = 0.0;
+  LineFit fit;
 };
 
-// Two lines near the same edge over the same stretch cannot both be its image (fragments of one
-// edge do not overlap). A claim with no such rival is confident; with rivals that all fit much
-// worse (distance over twice its own plus a pixel) it is the clear winner, good enough for the
-// pose but not reported (the clutter may be the better fit); otherwise it is dropped. A wrong
-// correspondence is worse than a missing one. `rivals` are all lines near visible edges.
-void SortClaims(const std::vector<std::optional<Segment2>>& projected,
-                const std::vector<ObservedLine>& lines, double overlap_px,
-                const std::vector<Claim>& rivals, const std::vector<Claim>& claims,
-                GuidedMatching* out) {
-  auto overlap = [&](int edge_index, int line_a, int line_b) {
-    const Segment2& edge = *projected[edge_index];
-    const Eigen::Vector2d axis = (edge.b - edge.a).normalized();
-    auto span = [&](const Segment2& s) {
-      const double t0 = (s.a - edge.a).dot(axis), t1 = (s.b - edge.a).dot(axis);
-      return std::make_pair(std::min(t0, t1), std::max(t0, t1));
-    };
-    const auto a = span(lines[line_a].pixels), b = span(lines[line_b].pixels);
-    return std::min(a.second, b.second) - std::max(a.first, b.first);
-  };
-  for (const Claim& claim : claims) {
-    bool rivalled = false, contested = false;
-    for (const Claim& rival : rivals) {
-      if (rival.edge != claim.edge || rival.line == claim.line ||
-          overlap(claim.edge, claim.line, rival.line) <= overlap_px) {
+// The result of guided matching at a pose.
+struct Assignment {
+  std::vector<Candidate> assigned;  // each line at most once; fragments of an edge do not overlap
+  std::vector<std::pair<int, int>> confident;
+  double lines_nats = 0.0;
+};
+
+// Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,
+// x, y, scale), the edge not hidden where the line lies.
+std::vector<Candidate> Candidates(const VerificationContext& context,
+                                  const std::vector<EdgeImage>& images, const Pose3Dof& pose,
+                                  double focal_scale, const Eigen::Matrix4d& pose_covariance,
+                                  const LineFitModel& model) {
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  const Eigen::Vector3d eye(pose.x, pose.y, context.height);
+  std::vector<Candidate> out;
+  if (context.pair_tests != nullptr) {
+    const long visible = std::count_if(images.begin(), images.end(),
+                                       [](const EdgeImage& image) { return image.visible; });
+    *context.pair_tests += visible * static_cast<long>(context.lines->size());
+  }
+  // Per edge: the ends' variances along the projection, and a distance beyond which no line
+  // can be within the gate: chi2 >= max(r_a^2, r_b^2) / trace(covariance), with the trace at most
+  // 2 sigma_d^2 + 2 (sigma_theta D)^2 + twice the pose term at the projection's ends.
+  std::vector<Eigen::Vector2d> end_variance(images.size());
+  std::vector<double> reject_px(images.size(), 0.0);
+  const double d = model.image_diagonal_px;
+  for (size_t e = 0; e < images.size(); ++e) {
+    const EdgeImage& image = images[e];
+    if (!image.visible) continue;
+    end_variance[e] = image.EndVariance(pose_covariance);
+    double pose_variance = 0.0;
+    for (const Eigen::Vector2d& end : {image.image.a, image.image.b}) {
+      const Eigen::Matrix<double, 1, 4> j =
+          Eigen::Vector3d(end.x(), end.y(), 1.0).transpose() * image.d_line;
+      pose_variance = std::max(pose_variance, (j * pose_covariance * j.transpose())(0, 0));
+    }
+    const double trace = 2.0 * model.offset_px * model.offset_px +
+                         2.0 * (model.angle_rad * d) * (model.angle_rad * d) + 4.0 * pose_variance;
+    reject_px[e] = std::sqrt(model.gate_chi2 * trace);
+  }
+  for (size_t l = 0; l < context.lines->size(); ++l) {
+    const Segment2& observed = (*context.lines)[l].pixels;
+    const Eigen::Vector3d qa(observed.a.x(), observed.a.y(), 1.0);
+    const Eigen::Vector3d qb(observed.b.x(), observed.b.y(), 1.0);
+    for (size_t e = 0; e < images.size(); ++e) {
+      const EdgeImage& image = images[e];
+      if (!image.visible ||
+          std::max(std::abs(image.line.dot(qa)), std::abs(image.line.dot(qb))) > reject_px[e]) {
         continue;
       }
-      rivalled = true;
-      contested = contested || rival.distance <= 2.0 * claim.distance + 1.0;
+      Eigen::Matrix<double, 2, 4> j;
+      j.row(0) = qa.transpose() * image.d_line;
+      j.row(1) = qb.transpose() * image.d_line;
+      LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model,
+                            end_variance[e]);
+      fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
+      if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
+      if (context.occlusion != nullptr &&
+          context.occlusion->Blocked(
+              eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
+        continue;
+      }
+      out.push_back({static_cast<int>(e), static_cast<int>(l), fit});
     }
-    if (contested) continue;
-    out->for_pose.emplace_back(claim.edge, claim.line);
-    if (!rivalled) out->confident.emplace_back(claim.edge, claim.line);
   }
+  return out;
 }
 
-// Extra distance (pixels, 3 sigma) a calibration error may put between a line and its edge's
-// projection: 3 focal_relative r, r the farthest endpoint's distance from the principal point.
-double CalibrationAllowance(const VerificationContext& context, const Segment2& s) {
-  const Eigen::Vector2d centre(context.camera->u0, context.camera->v0);
-  return 3.0 * context.focal_relative * std::max((s.a - centre).norm(), (s.b - centre).norm());
+bool Overlap(const LineFit& a, const LineFit& b, double tolerance) {
+  return std::min(a.hi, b.hi) - std::max(a.lo, b.lo) > tolerance;
 }
 
-// Matched edges, distances (eq. 9, eq. 10) and plausibility of the pairs at the pose.
-void Score(const VerificationContext& context, const VerificationOptions& options,
-           VerifiedPose* result) {
-  const std::vector<std::optional<Segment2>> projected =
-      ProjectEdges(context, result->pose, result->refinement.focal_scale);
+// Greedy assignment by likelihood ratio: each line to its best edge, unless a better line already
+// covers the same stretch of that edge (fragments of one edge do not overlap). A pair is
+// confident when its ratio exceeds every other explanation of its line (clutter, another edge)
+// and every rival line over the same stretch by report_nats.
+Assignment Assign(const VerificationContext& context, std::vector<Candidate> candidates,
+                  const VerificationOptions& options) {
+  const double overlap_tolerance = 3.0 * context.noise.offset_px;
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    if (a.fit.log_likelihood_ratio != b.fit.log_likelihood_ratio) {
+      return a.fit.log_likelihood_ratio > b.fit.log_likelihood_ratio;
+    }
+    return std::make_pair(a.line, a.edge) < std::make_pair(b.line, b.edge);
+  });
+  Assignment out;
+  std::vector<bool> line_used(context.lines->size(), false);
+  for (const Candidate& c : candidates) {
+    if (line_used[c.line]) continue;
+    // Fragments of one edge's image do not overlap and lie on one line.
+    const Segment2& piece = (*context.lines)[c.line].pixels;
+    const bool blocked = std::any_of(out.assigned.begin(), out.assigned.end(), [&](const auto& a) {
+      return a.edge == c.edge &&
+             (Overlap(a.fit, c.fit, overlap_tolerance) ||
+              FragmentChiSquare((*context.lines)[a.line].pixels, piece,
+                                context.noise.fragment_offset_px) > options.gate_chi2);
+    });
+    if (blocked) continue;
+    line_used[c.line] = true;
+    out.assigned.push_back(c);
+    out.lines_nats += c.fit.log_likelihood_ratio;
+  }
+  for (const Candidate& a : out.assigned) {
+    double rival = 0.0;  // clutter
+    for (const Candidate& c : candidates) {
+      if (c.line == a.line && c.edge != a.edge) rival = std::max(rival, c.fit.log_likelihood_ratio);
+      if (c.edge == a.edge && c.line != a.line && Overlap(a.fit, c.fit, overlap_tolerance)) {
+        rival = std::max(rival, c.fit.log_likelihood_ratio);
+      }
+    }
+    if (a.fit.log_likelihood_ratio - rival >= options.report_nats) {
+      out.confident.emplace_back(a.edge, a.line);
+    }
+  }
+  std::sort(out.confident.begin(), out.confident.end());
+  return out;
+}
+
+std::vector<std::pair<int, int>> Pairs(const Assignment& assignment) {
+  std::vector<std::pair<int, int>> pairs;
+  for (const Candidate& c : assignment.assigned)
+    pairs.emplace_back(c.edge, c.line);
+  return pairs;
+}
+
+// Wilson-Hilferty approximation of the chi-square quantile with `dof` degrees of freedom at
+// standard normal quantile z.
+double ChiSquareQuantile(double dof, double z) {
+  const double k = std::max(dof, 1.0);
+  const double c = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - c + z * std::sqrt(c), 3.0);
+}
+
+// Standard normal quantile for p in (0.975, 1) (Acklam's rational approximation, upper tail;
+// relative error below 1.2e-9).
+double NormalQuantile(double p) {
+  const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+  return -(((((-7.784894002430293e-03 * q - 3.223964580411365e-01) * q - 2.400758277161838e+00) *
+                 q -
+             2.549732539343734e+00) *
+                q +
+            4.374664141464968e+00) *
+               q +
+           2.938163982698783e+00) /
+         ((((7.784695709041462e-03 * q + 3.224671290700398e-01) * q + 2.445134137142996e+00) * q +
+           3.754408661907416e+00) *
+              q +
+          1.0);
+}
+
+// Plausibility checks and the eq. 9 / eq. 10 distances of the pairs.
+void Judge(const VerificationContext& context, const VerificationOptions& options,
+           const std::vector<EdgeImage>& images, VerifiedPose* result) {
   std::vector<double> distances;
   std::set<int> edges;
-  // Sums of d / max(mean distance, calibration allowance) and of the allowances.
-  double relative = 0.0, allowance = 0.0;
   for (const auto& [e, l] : result->pairs) {
     edges.insert(e);
-    const Segment2& line = (*context.lines)[l].pixels;
-    const double a = CalibrationAllowance(context, line);
-    distances.push_back(projected[e] ? SegmentDistance(*projected[e], line)
-                                     : std::numeric_limits<double>::infinity());
-    relative += distances.back() / std::hypot(options.max_mean_distance_px, a);
-    allowance += a;
+    distances.push_back(images[e].visible
+                            ? SegmentDistance(images[e].image, (*context.lines)[l].pixels)
+                            : std::numeric_limits<double>::infinity());
   }
-  const double n = std::max<double>(1.0, distances.size());
   result->matched_edges = static_cast<int>(edges.size());
   double sum = 0.0;
   for (double d : distances)
@@ -166,85 +318,45 @@ void Score(const VerificationContext& context, const VerificationOptions& option
   result->mean_distance_px = distances.empty() ? std::numeric_limits<double>::infinity()
                                                : sum / static_cast<double>(distances.size());
   result->score_px =
-      PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
+      distances.empty()
+          ? std::numeric_limits<double>::infinity()
+          : PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->plausible = relative / n <= 1.0 && InsidePrior(context, result->pose, options) &&
-                      result->matched_edges >= options.min_matches &&
-                      r.rms_px <= std::hypot(options.max_rms_px, 0.5 * allowance / n) &&
-                      r.position_sigma_m <= options.max_position_sigma_m &&
-                      std::abs(r.focal_scale - 1.0) <= 3.0 * options.refinement.focal_prior_sigma &&
-                      r.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  result->implausible_because.clear();
+  if (result->matched_edges < options.min_matches) {
+    result->implausible_because = "too few edges";
+  } else if (!InsidePrior(context, result->pose, r, options)) {
+    result->implausible_because = "outside the prior";
+  } else if (r.position_sigma_m > options.max_position_sigma_m ||
+             r.heading_sigma_rad > DegToRad(options.max_heading_sigma_deg)) {
+    result->implausible_because = "unobservable";
+  } else if (options.refinement.focal_prior_sigma > 0.0 &&
+             std::abs(r.focal_scale - 1.0) > 4.0 * options.refinement.focal_prior_sigma) {
+    result->implausible_because = "focal scale";
+  }
+  result->plausible = result->implausible_because.empty();
 }
 
 }  // namespace
 
+LineFitModel FitModel(const VerificationContext& context, const VerificationOptions& options) {
+  LineFitModel model;
+  model.offset_px = context.noise.offset_px;
+  model.angle_rad = DegToRad(context.noise.angle_deg);
+  model.image_diagonal_px = std::hypot(context.camera->width, context.camera->height);
+  model.gate_chi2 = options.gate_chi2;
+  model.extent_sigmas = options.extent_sigmas;
+  return model;
+}
+
 bool VerificationOptions::Check(std::string* why) const {
-  if (!(match_distance_px > 0.0) || !(match_angle_deg > 0.0) || guided_rounds < 0 ||
-      !(max_rms_px > 0.0) || min_matches < 2 || !(min_support >= 0.0 && min_support <= 1.0)) {
-    *why = "verification: thresholds must be positive, min_matches >= 2, min_support in [0, 1]";
+  if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
+      max_pair_tests < 1 || !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
+      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
+    *why = "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1)";
     return false;
   }
   return refinement.Check(why);
-}
-
-GuidedMatching GuidedMatches(const VerificationContext& context, const Pose3Dof& pose,
-                             double focal_scale, const VerificationOptions& options) {
-  const std::vector<std::optional<Segment2>> projected = ProjectEdges(context, pose, focal_scale);
-  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
-  const double max_angle = DegToRad(options.match_angle_deg);
-  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
-  const Eigen::Vector3d eye(pose.x, pose.y, context.height);
-  std::vector<Claim> claims, rivals;
-  std::vector<std::pair<double, int>> near;  // (distance, edge) under the thresholds
-  for (size_t l = 0; l < context.lines->size(); ++l) {
-    const Segment2& observed = (*context.lines)[l].pixels;
-    const double match_distance =
-        std::hypot(options.match_distance_px, CalibrationAllowance(context, observed));
-    const double rival_distance = options.rival_factor * match_distance;
-    near.clear();
-    for (size_t e = 0; e < projected.size(); ++e) {
-      if (!projected[e] || AngleBetween(*projected[e], observed) > max_angle) continue;
-      const double d = SegmentDistance(*projected[e], observed);
-      if (d < rival_distance) near.emplace_back(d, static_cast<int>(e));
-    }
-    std::sort(near.begin(), near.end());
-    // The nearest edge not hidden where the line lies claims it, unless another visible edge
-    // is nearly as near (two edges aligned in the image: the line cannot tell them apart).
-    int claimed = -1, visible = 0;
-    for (const auto& [d, e] : near) {
-      if (context.occlusion != nullptr &&
-          context.occlusion->Blocked(
-              eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
-        continue;
-      }
-      rivals.push_back({e, static_cast<int>(l), d});
-      if (visible++ == 0 && d < match_distance) claimed = e;
-    }
-    // Exactly one visible edge near the line, and near enough: it is the last rival pushed.
-    if (claimed >= 0 && visible == 1) claims.push_back(rivals.back());
-  }
-  GuidedMatching matching;
-  SortClaims(projected, *context.lines, options.overlap_px, rivals, claims, &matching);
-  return matching;
-}
-
-VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
-                     const VerificationOptions& options) {
-  VerifiedPose result = start;
-  for (int round = 0; round < options.guided_rounds; ++round) {
-    if (result.refinement.rms_px > 3.0 * options.max_rms_px) break;  // hopeless: skip re-matching
-    GuidedMatching guided =
-        GuidedMatches(context, result.pose, result.refinement.focal_scale, options);
-    if (guided.for_pose.size() < 2) break;
-    result.refinement =
-        RefinePose(ToLineMatches(context, guided.for_pose), *context.camera, context.height,
-                   context.tilt, result.pose, result.refinement.focal_scale, options.refinement);
-    result.pairs = std::move(guided.for_pose);
-    result.confident_pairs = std::move(guided.confident);
-    result.pose = result.refinement.pose;
-  }
-  Score(context, options, &result);
-  return result;
 }
 
 VerifiedPose RefineHypothesis(const VerificationContext& context,
@@ -257,7 +369,7 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
   for (const Pose3Dof& start : starts) {
     const PoseRefinementResult r = RefinePose(matches, *context.camera, context.height,
                                               context.tilt, start, options.refinement);
-    if (result.refinement.iterations == 0 || r.rms_px < result.refinement.rms_px) {
+    if (result.refinement.iterations == 0 || r.chi2 < result.refinement.chi2) {
       result.refinement = r;
     }
   }
@@ -265,68 +377,283 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
   return result;
 }
 
+bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOptions& options) {
+  const int dof = 2 * static_cast<int>(hypothesis.pairs.size()) - 3;
+  return hypothesis.refinement.chi2 <=
+         ChiSquareQuantile(dof, NormalQuantile(options.hypothesis_quantile));
+}
+
+namespace {
+
+// The largest subset of the hypothesis' pairs that agrees with one minimal pose (two of its
+// pairs, at least one non-vertical): each pair's whitened residuals there within
+// consensus_chi2. Returns the pairs and sets *pose; empty when no minimal pose exists.
+std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
+                                           const VerificationOptions& options,
+                                           const std::vector<std::pair<int, int>>& pairs,
+                                           Pose3Dof* pose) {
+  const std::vector<LineMatch> matches = ToLineMatches(context, pairs);
+  std::vector<std::pair<int, int>> best;
+  double best_chi2 = 0.0;
+  std::vector<std::pair<int, int>> inliers;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    for (size_t j = i + 1; j < pairs.size(); ++j) {
+      const auto [e1, l1] = pairs[i];
+      const auto [e2, l2] = pairs[j];
+      for (const Pose3Dof& candidate :
+           MinimalPoses((*context.lines)[l1], (*context.edges)[e1], (*context.lines)[l2],
+                        (*context.edges)[e2], context.height)) {
+        inliers.clear();
+        double chi2 = 0.0;
+        const PoseView view = ViewOf(candidate, context.height, context.tilt);
+        for (size_t k = 0; k < matches.size(); ++k) {
+          const double c = (matches[k].whitening *
+                            EndpointResiduals(matches[k], *context.camera, view, 1.0, nullptr))
+                               .squaredNorm();
+          if (c > options.consensus_chi2) continue;
+          inliers.push_back(pairs[k]);
+          chi2 += c;
+        }
+        if (inliers.size() > best.size() || (inliers.size() == best.size() && chi2 < best_chi2)) {
+          best = inliers;
+          best_chi2 = chi2;
+          *pose = candidate;
+        }
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
+                    VerifiedPose* hypothesis) {
+  if (ConsistentHypothesis(*hypothesis, options)) return true;
+  const std::vector<std::pair<int, int>> original = hypothesis->pairs;
+  {
+    // A leaf holding wrong pairs: restart from the pairs that agree with a minimal pose.
+    Pose3Dof start;
+    std::vector<std::pair<int, int>> agreeing =
+        Consensus(context, options, hypothesis->pairs, &start);
+    if (agreeing.size() < 3) return false;
+    hypothesis->pairs = std::move(agreeing);
+    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
+                                        context.height, context.tilt, start, options.refinement);
+    hypothesis->pose = hypothesis->refinement.pose;
+  }
+  while (!ConsistentHypothesis(*hypothesis, options)) {
+    if (hypothesis->pairs.size() <= 3) return false;
+    const std::vector<LineMatch> matches = ToLineMatches(context, hypothesis->pairs);
+    size_t worst = 0;
+    double worst_chi2 = -1.0;
+    for (size_t i = 0; i < matches.size(); ++i) {
+      const double chi2 =
+          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
+                                                    context.tilt, hypothesis->pose,
+                                                    hypothesis->refinement.focal_scale, nullptr))
+              .squaredNorm();
+      if (chi2 > worst_chi2) {
+        worst_chi2 = chi2;
+        worst = i;
+      }
+    }
+    hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
+    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
+                                        context.height, context.tilt, hypothesis->pose,
+                                        hypothesis->refinement.focal_scale, options.refinement);
+    hypothesis->pose = hypothesis->refinement.pose;
+  }
+  // Pairs dropped on the way that fit the consistent pose are taken back (the minimal pose of the
+  // consensus is rough), as long as the hypothesis stays consistent.
+  for (int round = 0; round < 2; ++round) {
+    VerifiedPose trial = *hypothesis;
+    const std::vector<LineMatch> matches = ToLineMatches(context, original);
+    for (size_t i = 0; i < original.size(); ++i) {
+      if (std::find(trial.pairs.begin(), trial.pairs.end(), original[i]) != trial.pairs.end()) {
+        continue;
+      }
+      const double chi2 =
+          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
+                                                    context.tilt, hypothesis->pose,
+                                                    hypothesis->refinement.focal_scale, nullptr))
+              .squaredNorm();
+      if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
+    }
+    if (trial.pairs.size() == hypothesis->pairs.size()) break;
+    trial.refinement = RefinePose(ToLineMatches(context, trial.pairs), *context.camera,
+                                  context.height, context.tilt, hypothesis->pose,
+                                  hypothesis->refinement.focal_scale, options.refinement);
+    trial.pose = trial.refinement.pose;
+    if (!ConsistentHypothesis(trial, options)) break;
+    *hypothesis = std::move(trial);
+  }
+  return true;
+}
+
+double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
+                          const VerifiedPose& hypothesis) {
+  const std::vector<EdgeImage> images =
+      ProjectEdges(context, hypothesis.pose, hypothesis.refinement.focal_scale);
+  const LineFitModel model = FitModel(context, options);
+  double total = 0.0;
+  for (const auto& [e, l] : hypothesis.pairs) {
+    if (!images[e].visible) continue;
+    const LineFit fit =
+        FitLine(images[e].image, (*context.lines)[l].pixels, Eigen::Matrix2d::Zero(), model);
+    total += std::max(0.0, fit.log_likelihood_ratio - (*context.lines)[l].clutter_log_density);
+  }
+  return total;
+}
+
+std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+                                              const VerificationOptions& options,
+                                              const VerifiedPose& verified) {
+  const double sigma_theta = DegToRad(context.noise.angle_deg);
+  std::vector<Eigen::Matrix2d> whitening;
+  for (const ObservedLine& line : *context.lines) {
+    const double half = 0.5 * line.length_px;
+    whitening.push_back(
+        Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta)));
+  }
+  std::vector<std::pair<int, int>> fitting;
+  const PoseView view = ViewOf(verified.pose, context.height, context.tilt);
+  for (size_t e = 0; e < context.edges->size(); ++e) {
+    const MatchEdge& edge = (*context.edges)[e];
+    const Eigen::Vector3d image_line = ProjectedEdgeLine(edge.a, edge.b, *context.camera, view,
+                                                         verified.refinement.focal_scale, nullptr);
+    for (size_t l = 0; l < context.lines->size(); ++l) {
+      const Segment2& s = (*context.lines)[l].pixels;
+      const Eigen::Vector2d r(image_line.dot(Eigen::Vector3d(s.a.x(), s.a.y(), 1.0)),
+                              image_line.dot(Eigen::Vector3d(s.b.x(), s.b.y(), 1.0)));
+      if ((whitening[l] * r).squaredNorm() <= options.gate_chi2) {
+        fitting.emplace_back(static_cast<int>(e), static_cast<int>(l));
+      }
+    }
+  }
+  return fitting;
+}
+
+VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
+                     const VerificationOptions& options) {
+  const LineFitModel model = FitModel(context, options);
+  VerifiedPose result = start;
+  std::vector<std::pair<int, int>> previous;
+  Assignment assignment;
+  std::vector<EdgeImage> images;
+  for (int round = 0;; ++round) {
+    images = ProjectEdges(context, result.pose, result.refinement.focal_scale);
+    assignment = Assign(context,
+                        Candidates(context, images, result.pose, result.refinement.focal_scale,
+                                   result.refinement.covariance, model),
+                        options);
+    std::vector<std::pair<int, int>> pairs = Pairs(assignment);
+    std::sort(pairs.begin(), pairs.end());
+    if (pairs == previous || round == options.guided_rounds || pairs.size() < 2) break;
+    result.refinement =
+        RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
+                   result.pose, result.refinement.focal_scale, options.refinement);
+    result.pose = result.refinement.pose;
+    previous = std::move(pairs);
+  }
+  result.pairs = Pairs(assignment);
+  result.confident_pairs = assignment.confident;
+  result.evidence = PoseEvidence();
+  result.evidence.lines_nats = assignment.lines_nats;
+  result.evidence_complete = false;
+  Judge(context, options, images, &result);
+  return result;
+}
+
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs,
                               const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options) {
-  return Rematch(context, RefineHypothesis(context, pairs, starts, options), options);
+  VerifiedPose hypothesis = RefineHypothesis(context, pairs, starts, options);
+  if (!TrimHypothesis(context, options, &hypothesis)) {
+    hypothesis.implausible_because = "inconsistent hypothesis";
+    return hypothesis;
+  }
+  return Rematch(context, hypothesis, options);
+}
+
+void CompleteEvidence(const VerificationContext& context, const VerificationOptions& options,
+                      VerifiedPose* verified) {
+  if (verified->evidence_complete) return;
+  const std::vector<EdgeImage> images =
+      ProjectEdges(context, verified->pose, verified->refinement.focal_scale);
+  const LineFitModel model = FitModel(context, options);
+  // Spans of the assigned lines along their edges' images.
+  std::vector<std::vector<std::pair<double, double>>> spans(images.size());
+  for (const auto& [e, l] : verified->pairs) {
+    if (!images[e].visible) continue;
+    const LineFit fit =
+        FitLine(images[e].image, (*context.lines)[l].pixels, Eigen::Matrix2d::Zero(), model);
+    spans[e].emplace_back(fit.lo, fit.hi);
+  }
+  const Eigen::Vector3d eye(verified->pose.x, verified->pose.y, context.height);
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, verified->refinement.focal_scale);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(verified->pose, context));
+  const double log_detected = std::log(context.noise.detection_probability);
+  const double log_missed = std::log(1.0 - context.noise.detection_probability);
+  PoseEvidence& evidence = verified->evidence;
+  evidence.edges_nats = evidence.predicted_px = evidence.covered_px = 0.0;
+  for (size_t e = 0; e < images.size(); ++e) {
+    const EdgeImage& image = images[e];
+    if (!image.visible) continue;
+    const double length = image.image.Length();
+    const Eigen::Vector2d axis = (image.image.b - image.image.a) / length;
+    // Position along the image of the point at parameter t of the clipped world segment.
+    auto along = [&](double t) {
+      const Eigen::Vector3d point = image.world.a + t * (image.world.b - image.world.a);
+      return (camera.Project(cam_from_world * point) - image.image.a).dot(axis);
+    };
+    const int samples =
+        std::max(1, static_cast<int>(std::ceil(length / options.visibility_step_px)));
+    double visible = 0.0, covered = 0.0, start = 0.0;
+    for (int k = 0; k < samples; ++k) {
+      const double end = k + 1 == samples ? length : along((k + 1.0) / samples);
+      const double t = (k + 0.5) / samples;
+      if (context.occlusion == nullptr ||
+          !context.occlusion->Blocked(eye, image.world.a + t * (image.world.b - image.world.a))) {
+        visible += end - start;
+        const double middle = 0.5 * (start + end);
+        const bool is_covered = std::any_of(spans[e].begin(), spans[e].end(), [&](const auto& s) {
+          return middle >= s.first && middle <= s.second;
+        });
+        covered += is_covered ? end - start : 0.0;
+      }
+      start = end;
+    }
+    if (visible < options.min_detectable_px) continue;
+    const double fraction = std::min(1.0, covered / visible);
+    evidence.predicted_px += visible;
+    evidence.covered_px += std::min(covered, visible);
+    evidence.edges_nats += fraction * log_detected + (1.0 - fraction) * log_missed;
+  }
+  verified->evidence_complete = true;
+}
+
+double RequiredEvidence(const VerificationContext& context, const VerificationOptions& options,
+                        const VerifiedPose& verified) {
+  if (context.prior == nullptr) return options.chance_nats;
+  const PriorRegion& prior = *context.prior;
+  const double prior_volume = kPi * std::max(prior.radius, 0.01) * std::max(prior.radius, 0.01) *
+                              std::max(prior.heading.Width(), DegToRad(0.1));
+  const double det = verified.refinement.covariance.topLeftCorner<3, 3>().determinant();
+  if (!(det > 0.0) || !std::isfinite(det)) return std::numeric_limits<double>::infinity();
+  const double pose_volume = std::pow(2.0 * kPi, 1.5) * std::sqrt(det);
+  return options.chance_nats + std::max(0.0, std::log(prior_volume / pose_volume));
 }
 
 bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
   if (a.plausible != b.plausible) return a.plausible;
-  if (a.matched_edges != b.matched_edges) return a.matched_edges > b.matched_edges;
-  return a.mean_distance_px < b.mean_distance_px;
+  return a.evidence.Score() > b.evidence.Score();
 }
 
-PoseEvidence Evidence(const VerificationContext& context, const WireframeModel& model,
-                      const OcclusionTester& occlusion, const VerifiedPose& verified,
-                      const VerificationOptions& options) {
-  EdgeProjectionOptions projection;
-  projection.sample_step_px = 6.0;
-  projection.min_length_px = 2.0;
-  const std::vector<ProjectedEdge> pieces = ProjectVisibleEdges(
-      model, occlusion, CamFromWorld(Full(verified.pose, context)),
-      ScaledCamera(*context.camera, verified.refinement.focal_scale), projection);
-  std::map<int, double> visible_length;
-  for (const ProjectedEdge& p : pieces)
-    visible_length[p.edge_id] += p.image.Length();
-  // A line supports a visible piece when it lies near it (eq. 9 distance and angle), weighted by
-  // exp(-d^2 / 2 sigma^2): evidence depends on the pose only, not on which lines were kept as
-  // correspondences, and a close fit counts more than a loose one.
-  const double max_angle = DegToRad(options.support_angle_deg);
-  const size_t num_lines = context.lines->size();
-  std::vector<double> weight_of_line(num_lines, 0.0);
-  PoseEvidence evidence;
-  for (const ProjectedEdge& p : pieces) {
-    const bool counted = visible_length[p.edge_id] >= options.support_min_length_px;
-    const double length = p.image.Length();
-    const Eigen::Vector2d axis = (p.image.b - p.image.a) / length;
-    double piece_covered = 0.0, piece_weighted = 0.0;
-    for (size_t l = 0; l < num_lines; ++l) {
-      const Segment2& s = (*context.lines)[l].pixels;
-      if (AngleBetween(p.image, s) > max_angle) continue;
-      const double d = SegmentDistance(p.image, s);
-      const double allowance = CalibrationAllowance(context, s);
-      if (d > std::hypot(options.support_distance_px, allowance)) continue;
-      const double sigma = std::hypot(options.evidence_sigma_px, allowance / 3.0);
-      const double w = std::exp(-0.5 * d * d / (sigma * sigma));
-      weight_of_line[l] = std::max(weight_of_line[l], w);
-      double t0 = (s.a - p.image.a).dot(axis), t1 = (s.b - p.image.a).dot(axis);
-      if (t0 > t1) std::swap(t0, t1);
-      const double overlap = std::max(0.0, std::min(t1, length) - std::max(t0, 0.0));
-      piece_covered += overlap;
-      piece_weighted += w * overlap;
-    }
-    if (!counted) continue;
-    evidence.predicted_px += length;
-    evidence.covered_px += std::min(piece_covered, length);
-    evidence.fitted_px += std::min(piece_weighted, length);
-  }
-  for (size_t l = 0; l < num_lines; ++l) {
-    evidence.explained_px +=
-        weight_of_line[l] * ((*context.lines)[l].pixels.Length() + options.line_bonus_px);
-  }
-  return evidence;
+bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options) {
+  return std::hypot(a.x - b.x, a.y - b.y) <= options.same_pose_m &&
+         std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(options.same_pose_deg);
 }
 
 }  // namespace linetrack

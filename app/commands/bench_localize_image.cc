@@ -152,7 +152,8 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   LineExtractionOptions line_options;
   line_options.detector = *detector;
   LineExtractor extractor(line_options, case_options.camera);
-  LocalizerOptions localizer_options = DetectedLineMatcherOptions({});
+  LocalizerOptions localizer_options;
+  localizer_options.noise = DetectedLineNoise();
   localizer_options.noise.focal_relative = opt.focal_error;
   const Localizer localizer(model, &regions, &area, case_options.camera, localizer_options);
 
@@ -210,13 +211,10 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
         << std::setprecision(0) << RadToDeg(bounds.delta_phi)
         << " deg) drawn as linetrack synth draws them, calibration "
         << "error sigma " << std::setprecision(3) << opt.calibration_sigma
-        << "; matcher set for detected lines (DetectedLineMatcherOptions): line noise "
+        << "; matcher set for detected lines (DetectedLineNoise): line noise "
         << std::setprecision(1) << localizer_options.noise.offset_px << " px, "
-        << localizer_options.noise.angle_deg << " deg, match distance "
-        << localizer_options.verification.match_distance_px << " px, "
-        << localizer_options.verification.match_angle_deg << " deg; focal error "
-        << std::setprecision(3) << opt.focal_error << "; detector " << opt.detector
-        << ", one thread.\n\n"
+        << localizer_options.noise.angle_deg << " deg; focal error " << std::setprecision(3)
+        << opt.focal_error << "; detector " << opt.detector << ", one thread.\n\n"
         << "| correct | no answer | wrong but accurate | wrong | pose within 0.2 m, 3 deg | "
            "lines ms (median / p90) | "
            "matcher ms (median / p90) | total ms (median / p90) | segments (median) | pose "

@@ -2,6 +2,9 @@
 // 4.1), for the interpretation tree and for the hypothesise-and-test baseline, side by side.
 #include <spdlog/spdlog.h>
 
+#include <map>
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
@@ -11,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "matching/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
 #include "models/synthetic_scenes.h"
@@ -39,7 +43,9 @@ struct BenchMatchOptions {
   std::vector<std::string> series = {"qi1", "qi2", "qi3", "wide"};
   bool baseline = true;
   int baseline_samples = 200000;
+  int clutter = 0;  // clutter lines per scene (0: the paper's 5 to 12)
   std::string out_path;
+  std::string diagnose_path;  // JSON lines: every scene the tree does not answer correctly
 };
 
 Series SeriesByName(const std::string& name) {
@@ -65,27 +71,118 @@ double Percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
-void Score(const SyntheticScene& scene, const LocalizationResult& result, double ms, Tally* tally) {
-  tally->hypotheses.push_back(result.hypotheses);
-  tally->times_ms.push_back(ms);
-  if (!result.found) {
-    ++tally->none;
-    return;
+enum class Outcome { kCorrect, kNone, kWrongAccurate, kWrong };
+
+const char* OutcomeName(Outcome o) {
+  switch (o) {
+    case Outcome::kCorrect:
+      return "correct";
+    case Outcome::kNone:
+      return "no answer";
+    case Outcome::kWrongAccurate:
+      return "wrong but accurate";
+    case Outcome::kWrong:
+      return "wrong";
   }
+  return "";
+}
+
+Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result) {
+  if (!result.found) return Outcome::kNone;
   const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
   const bool all_true = std::all_of(result.matches.begin(), result.matches.end(),
                                     [&](const auto& m) { return truth.count(m) > 0; });
   const double dp = std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y);
   const double dh = RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)));
-  if (all_true && !result.matches.empty()) {
-    ++tally->correct;
-    tally->position_error_m.push_back(dp);
-    tally->heading_error_deg.push_back(dh);
-  } else if (dp <= kAccuratePositionM && dh <= kAccurateHeadingDeg) {
-    ++tally->wrong_accurate;
-  } else {
-    ++tally->wrong;
+  if (all_true && !result.matches.empty()) return Outcome::kCorrect;
+  if (dp <= kAccuratePositionM && dh <= kAccurateHeadingDeg) return Outcome::kWrongAccurate;
+  return Outcome::kWrong;
+}
+
+Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, double ms,
+              Tally* tally) {
+  tally->hypotheses.push_back(result.hypotheses);
+  tally->times_ms.push_back(ms);
+  const Outcome outcome = Judge(scene, result);
+  switch (outcome) {
+    case Outcome::kNone:
+      ++tally->none;
+      break;
+    case Outcome::kWrongAccurate:
+      ++tally->wrong_accurate;
+      break;
+    case Outcome::kWrong:
+      ++tally->wrong;
+      break;
+    case Outcome::kCorrect:
+      ++tally->correct;
+      tally->position_error_m.push_back(
+          std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y));
+      tally->heading_error_deg.push_back(
+          RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading))));
+      break;
   }
+  return outcome;
+}
+
+// The first stage at which the truth is lost (see matching/diagnosis.h).
+std::string Classify(const TruthDiagnosis& d, const LocalizationResult& result) {
+  if (!d.plausible && d.implausible_because == "unobservable") return "uninformative truth";
+  if (d.candidate_edges < d.true_edges) return "true edge not a candidate";
+  if (d.unary_edges < d.candidate_edges) return "true pair cut by a unary constraint";
+  if (!d.region_consistent) return "truth's region emptied";
+  if (!d.region_contains_truth) return "truth's region misses the true pose";
+  if (!d.plausible) return "truth implausible: " + d.implausible_because;
+  if (result.budget_exhausted) return "search budget exhausted";
+  if (result.found) return "truth outranked";
+  const std::string& r = result.reason;
+  return "truth plausible, no answer: " + r.substr(0, r.find_first_of("(0123456789"));
+}
+
+nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const LocalizationResult& result,
+                                     Outcome outcome, const TruthDiagnosis& d,
+                                     const std::string& category) {
+  nlohmann::ordered_json pairs = nlohmann::ordered_json::array();
+  for (const TruthPairCheck& p : d.pairs) {
+    pairs.push_back({{"edge", p.edge_id},
+                     {"line", p.line},
+                     {"vertical", p.vertical},
+                     {"candidate", p.candidate},
+                     {"unary", p.unary_pass},
+                     {"sigmas", {p.first_sigmas, p.second_sigmas}},
+                     {"distance_px", p.distance_px},
+                     {"guided", p.guided}});
+  }
+  const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
+  nlohmann::ordered_json wrong = nlohmann::ordered_json::array();
+  for (const auto& m : result.matches) {
+    if (!truth.count(m)) wrong.push_back({m.first, m.second});
+  }
+  return {{"scene", scene.index},
+          {"outcome", OutcomeName(outcome)},
+          {"category", category},
+          {"reason", result.reason},
+          {"hypotheses", result.hypotheses},
+          {"budget_exhausted", result.budget_exhausted},
+          {"pose_error",
+           {std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y),
+            RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)))}},
+          {"wrong_matches", wrong},
+          {"true_edges", d.true_edges},
+          {"candidate_edges", d.candidate_edges},
+          {"unary_edges", d.unary_edges},
+          {"region_consistent", d.region_consistent},
+          {"region_emptied_by", d.region_emptied_by},
+          {"region_contains_truth", d.region_contains_truth},
+          {"plausible", d.plausible},
+          {"implausible_because", d.implausible_because},
+          {"truth_matched_edges", d.matched_edges},
+          {"truth_rms_px", d.rms_px},
+          {"truth_evidence", d.evidence_score},
+          {"chosen_evidence",
+           result.finalists.empty() ? 0.0 : result.finalists.front().evidence.Score()},
+          {"observability", {d.position_sigma_m, d.heading_sigma_deg}},
+          {"pairs", pairs}};
 }
 
 std::string Row(const std::string& matcher, const Tally& t) {
@@ -109,9 +206,12 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
   for (const std::string& name : opt.series)
     series.push_back(SeriesByName(name));
 
+  std::unique_ptr<std::ostringstream> diagnosis;
+  if (!opt.diagnose_path.empty()) diagnosis = std::make_unique<std::ostringstream>();
   std::ostringstream table;
   table << "Synthetic scenes of the paper's section 4.1 on " << opt.model_path << " (" << opt.count
         << " per series, seed " << opt.seed
+        << (opt.clutter > 0 ? ", " + std::to_string(opt.clutter) + " clutter lines per scene" : "")
         << "); times per localisation on this machine, one thread.\n\n"
         << "| prior | matcher | correct | no answer | wrong but accurate | wrong | "
            "hypotheses verified (median / max) | time ms (median / p99) | pose error of "
@@ -123,6 +223,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     scene_options.count = opt.count;
     scene_options.delta_t = s.delta_t;
     scene_options.delta_phi = DegToRad(s.delta_phi);
+    if (opt.clutter > 0) scene_options.min_clutter = scene_options.max_clutter = opt.clutter;
     spdlog::info("{}: generating {} scenes", s.name, opt.count);
     const std::vector<SyntheticScene> scenes = GenerateScenes(model, area, scene_options);
 
@@ -133,27 +234,34 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);
     Tally tree_tally, baseline_tally;
+    std::map<std::string, int> categories;
     for (size_t i = 0; i < scenes.size(); ++i) {
       const SyntheticScene& scene = scenes[i];
-      LocalizationProblem problem;
-      problem.lines = scene.lines;
-      problem.prior = scene.prior;
-      problem.delta_t = scene.delta_t;
-      problem.delta_phi = scene.delta_phi;
-      problem.height = scene.height;
-      problem.tilt = scene.tilt;
+      const LocalizationProblem problem = ProblemOf(scene);
       for (int m = 0; m < (opt.baseline ? 2 : 1); ++m) {
         const auto start = std::chrono::steady_clock::now();
         const LocalizationResult result = (m == 0 ? tree : baseline).Localize(problem);
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        Score(scene, result, ms, m == 0 ? &tree_tally : &baseline_tally);
+        const Outcome outcome = Score(scene, result, ms, m == 0 ? &tree_tally : &baseline_tally);
+        if (m == 0 && diagnosis && outcome != Outcome::kCorrect) {
+          const TruthDiagnosis d =
+              DiagnoseTruth(tree, problem, scene.truth.Planar(), scene.matches);
+          const std::string category = Classify(d, result);
+          ++categories[category];
+          nlohmann::ordered_json j = DiagnosisJson(scene, result, outcome, d, category);
+          j["series"] = s.name;
+          *diagnosis << j.dump() << "\n";
+        }
       }
       if ((i + 1) % 50 == 0) spdlog::info("{}: {}/{} scenes", s.name, i + 1, scenes.size());
     }
     table << "| " << s.name << " " << Row("tree", tree_tally) << "\n";
     if (opt.baseline) table << "| " << s.name << " " << Row("baseline", baseline_tally) << "\n";
+    for (const auto& [category, count] : categories) {
+      spdlog::info("{}: {} scene(s): {}", s.name, count, category);
+    }
     if (s.paper[0] >= 0) {
       table << "| " << s.name << " | paper (RAS 2005, Table 3) | " << s.paper[0] << " ("
             << std::fixed << std::setprecision(1) << 100.0 * s.paper[0] / 430.0 << " %) | "
@@ -163,6 +271,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
   }
   std::cout << table.str();
   if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, table.str());
+  if (diagnosis) WriteFileAtomically(opt.diagnose_path, diagnosis->str());
   return kExitOk;
 }
 
@@ -182,9 +291,16 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--baseline-samples", opt->baseline_samples,
                   "Random pairs the baseline may draw per case")
       ->capture_default_str();
+  cmd->add_option("--clutter", opt->clutter,
+                  "Clutter lines per scene (default: the paper's 5 to 12), e.g. 200 for the "
+                  "search budget");
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
+  cmd->add_option("--diagnose", opt->diagnose_path,
+                  "Write a JSON line per scene the tree does not answer correctly: where the "
+                  "true correspondences are lost (matching/diagnosis.h)");
   cmd->callback([opt, action] {
     if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
+    if (opt->clutter < 0) throw CLI::ValidationError("--clutter", "must be at least 0");
     *action = [opt] { return RunBenchMatch(*opt); };
   });
 }

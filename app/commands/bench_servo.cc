@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "app/localize_image.h"
+#include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "tracking/live/servo_bench.h"
@@ -66,7 +67,7 @@ int RunBenchServo(BenchServoCommandOptions opt) {
     throw InputError("--estimator: expected tracker or truth, got '" + opt.estimator + "'");
   }
   opt.bench.use_tracker = opt.estimator == "tracker";
-  opt.bench.tracker.matcher = DetectedLineMatcherOptions({});
+  opt.bench.tracker.matcher.noise = DetectedLineNoise();
   if (!opt.settings.empty()) opt.bench.tracker.settings = ReadTrackerSettings(opt.settings);
   std::string why;
   if (!opt.bench.Check(&why)) throw InputError("bench servo: " + why);

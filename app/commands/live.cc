@@ -22,6 +22,7 @@
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
+#include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/trajectory_io.h"
@@ -209,7 +210,7 @@ int RunLive(const LiveCommandOptions& opt) {
   if (!opt.prior_file.empty() && inputs.priors.empty()) {
     throw InputError(opt.prior_file + ": no prior rows");
   }
-  inputs.tracker.matcher = DetectedLineMatcherOptions({});
+  inputs.tracker.matcher.noise = DetectedLineNoise();
   if (!opt.settings.empty()) inputs.tracker.settings = ReadTrackerSettings(opt.settings);
   std::optional<NavigableArea> area;
   if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||

@@ -13,6 +13,7 @@
 #include "app/image_overlay.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 
 namespace linetrack::app {
@@ -34,7 +35,7 @@ struct LocalizeOptions {
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
-  if (!opt.image_path.empty()) options = DetectedLineMatcherOptions(options);
+  if (!opt.image_path.empty()) options.noise = DetectedLineNoise();
   if (!opt.line_noise.empty()) {
     const std::vector<double> v = ParseNumbers(opt.line_noise, 2, "--line-noise");
     options.noise.offset_px = v[0];

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -122,7 +123,7 @@ int WriteOneView(const RenderCommandOptions& opt, const RobotPose& pose, SceneRe
   const double ms = Milliseconds(std::chrono::steady_clock::now() - start);
   WriteFileAtomically(opt.out, EncodePng(image));
   std::cout << "wrote " << opt.out << " (" << image.getWidth() << "x" << image.getHeight()
-            << ", rendered in " << ms << " ms)" << std::endl;
+            << ", rendered in " << std::fixed << std::setprecision(1) << ms << " ms)" << std::endl;
   return kExitOk;
 }
 
@@ -155,8 +156,9 @@ int WriteSequence(const RenderCommandOptions& opt, const std::vector<SequenceFra
   WriteCameraAtomically((dir / "camera.xml").string(),
                         opt.undistorted ? camera.Undistorted() : camera);
   std::cout << "wrote " << frames.size() << " frames (" << camera.width << "x" << camera.height
-            << ") to " << opt.out << ": median " << Median(render_ms) << " ms per frame to render, "
-            << Median(total_ms) << " ms with PNG encoding and writing" << std::endl;
+            << ") to " << opt.out << ": median " << std::fixed << std::setprecision(1)
+            << Median(render_ms) << " ms per frame to render, " << Median(total_ms)
+            << " ms with PNG encoding and writing" << std::endl;
   return kExitOk;
 }
 

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,7 @@
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "app/replay_output.h"
+#include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/occlusion.h"
 #include "tracking/capture/video_source.h"
@@ -212,8 +214,10 @@ int RunReplay(const ReplayOptions& opt) {
   std::unique_ptr<Localizer> localizer;
   std::unique_ptr<Relocalizer> relocalizer;
   if (s.robot) {
+    LocalizerOptions matcher;
+    matcher.noise = DetectedLineNoise();  // lines from LineExtractor
     localizer = std::make_unique<Localizer>(*loaded.model, loaded.regions.get(), loaded.area.get(),
-                                            s.camera, DetectedLineMatcherOptions({}));
+                                            s.camera, matcher);
     RelocalizationOptions relocalization;
     relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
     // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
@@ -344,8 +348,8 @@ int RunReplay(const ReplayOptions& opt) {
             << static_cast<int>(summary["throughput_fps"].get<double>())
             << " frames/s without the overlay";
   if (summary.contains("ground_truth")) {
-    std::cout << "; ATE " << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0
-              << " cm, worst "
+    std::cout << std::fixed << std::setprecision(2) << "; ATE "
+              << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0 << " cm, worst "
               << summary["ground_truth"]["translation_m"]["max"].get<double>() * 100.0 << " cm / "
               << summary["ground_truth"]["rotation_deg"]["max"].get<double>() << " deg";
   }

@@ -103,6 +103,28 @@ TEST(AravisFake, Rgb8GreyDependsOnlyOnTheRampValue) {
   EXPECT_GT(*hi - *lo, 50);  // a real colour map, not a constant image
 }
 
+TEST(AravisFake, LatestOnlyDeliversTheNewestWaitingFrame) {
+  AravisSourceOptions options = InProcessFake("Mono8");
+  options.latest_only = true;
+  AravisSource source(options);
+  Frame frame;
+  ASSERT_EQ(source.Grab(&frame), FrameStatus::kOk) << source.LastError();
+  const std::uint64_t first_id = frame.frame_id;
+  // A consumer slower than the camera: frames pile up in the stream's output queue.
+  constexpr int kBacklog = 3;
+  const Clock::time_point start = Clock::now();
+  while (source.WaitingFrames() < kBacklog)
+    ASSERT_LT(SecondsSince(start), kStreamDeadlineS) << "no backlog of frames formed";
+  ASSERT_EQ(source.Grab(&frame), FrameStatus::kOk) << source.LastError();
+  std::string where;
+  EXPECT_TRUE(IsRampOfId(frame.image, frame.frame_id, &where)) << where;
+  const SourceStats stats = source.Stats();
+  EXPECT_GE(stats.skipped, kBacklog - 1);
+  EXPECT_EQ(stats.delivered, 2);
+  // Every frame between the two deliveries was either passed over or lost on the way.
+  EXPECT_EQ(FrameIdGap(first_id, frame.frame_id, kGigEWrap), stats.skipped + stats.missed);
+}
+
 void ExpectOpenError(const AravisSourceOptions& options, const std::string& fragment) {
   try {
     AravisSource source(options);

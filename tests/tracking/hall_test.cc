@@ -84,8 +84,6 @@ TrackedRun TrackHall(Hide hide) {
   // The matcher set for detected lines, as `linetrack localize --image` and `replay` use it.
   LocalizerOptions matcher;
   matcher.noise = DetectedLineNoise();
-  matcher.verification.match_distance_px = 2.5;
-  matcher.verification.match_angle_deg = 2.0;
   const Localizer localizer(hall.model, &regions, &area, hall.camera, matcher);
   const Relocalizer relocalizer(localizer, MakeLineExtractorFunction(LineExtractionOptions()));
   EdgeTracker tracker(kSource + "/models/hall.cao", hall.camera, TrackerSettings());

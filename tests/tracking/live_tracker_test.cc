@@ -53,8 +53,6 @@ const Hall& TheHall() {
 std::unique_ptr<TrackerPoseEstimator> Tracker() {
   TrackerEstimatorOptions options;
   options.matcher.noise = DetectedLineNoise();
-  options.matcher.verification.match_distance_px = 2.5;
-  options.matcher.verification.match_angle_deg = 2.0;
   return std::make_unique<TrackerPoseEstimator>(TheHall().model, TheHall().area, TheHall().camera,
                                                 options);
 }

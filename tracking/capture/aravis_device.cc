@@ -281,6 +281,16 @@ ArvBuffer* AravisDevice::Pop(double timeout_s) {
   return arv_stream_timeout_pop_buffer(stream_, timeout_us);
 }
 
+ArvBuffer* AravisDevice::TryPop() {
+  return arv_stream_try_pop_buffer(stream_);
+}
+
+int AravisDevice::WaitingBuffers() const {
+  gint n_input = 0, n_output = 0;
+  arv_stream_get_n_buffers(stream_, &n_input, &n_output);
+  return n_output;
+}
+
 void AravisDevice::Push(ArvBuffer* buffer) {
   arv_stream_push_buffer(stream_, buffer);
 }

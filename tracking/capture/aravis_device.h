@@ -35,6 +35,8 @@ class AravisDevice {
 
   // The next filled buffer, or nullptr after `timeout_s`. Give it back with Push().
   ArvBuffer* Pop(double timeout_s);
+  ArvBuffer* TryPop();         // a buffer already waiting in the output queue, or nullptr
+  int WaitingBuffers() const;  // buffers in the output queue (filled, not yet popped)
   void Push(ArvBuffer* buffer);
 
   // Converts a SUCCESS buffer to a grey frame (image, timestamps, frame id).

@@ -141,6 +141,7 @@ class AravisSource::Impl {
     if (!device_ && !TryRecover(deadline)) return FrameStatus::kDeviceLost;
     for (;;) {
       ArvBuffer* buffer = device_->Pop(std::max(0.001, SecondsUntil(deadline)));
+      if (buffer != nullptr && options_.latest_only) buffer = NewestWaiting(buffer);
       if (buffer != nullptr) {
         if (arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS) {
           std::string why;
@@ -171,6 +172,7 @@ class AravisSource::Impl {
   std::string Describe() const { return description_; }
   std::string LastError() const { return last_error_; }
   std::uint64_t FrameIdWrap() const { return frame_id_wrap_; }
+  int WaitingFrames() const { return device_ ? device_->WaitingBuffers() : 0; }
 
   SourceStats Stats() const {
     SourceStats stats = stats_;
@@ -183,14 +185,40 @@ class AravisSource::Impl {
   }
 
  private:
-  void Delivered(Frame* frame) {
-    frame->index = stats_.delivered++;
+  // `buffer` or, when newer complete buffers already wait behind it, the newest of them; the
+  // buffers passed over go back to the pool and count as skipped.
+  ArvBuffer* NewestWaiting(ArvBuffer* buffer) {
+    while (ArvBuffer* newer = device_->TryPop()) {
+      if (arv_buffer_get_status(newer) != ARV_BUFFER_STATUS_SUCCESS) {
+        device_->Push(newer);
+        ++stats_.incomplete;
+        continue;
+      }
+      if (arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS) {
+        Seen(arv_buffer_get_frame_id(buffer));
+        ++stats_.skipped;
+      } else {
+        ++stats_.incomplete;
+      }
+      device_->Push(buffer);
+      buffer = newer;
+    }
+    return buffer;
+  }
+
+  // Accounts for a frame id received (delivered or skipped): gaps before it were missed.
+  void Seen(std::uint64_t frame_id) {
     if (have_previous_id_) {
-      const std::int64_t gap = FrameIdGap(previous_id_, frame->frame_id, frame_id_wrap_);
+      const std::int64_t gap = FrameIdGap(previous_id_, frame_id, frame_id_wrap_);
       if (gap > 0) stats_.missed += gap;
     }
-    previous_id_ = frame->frame_id;
+    previous_id_ = frame_id;
     have_previous_id_ = true;
+  }
+
+  void Delivered(Frame* frame) {
+    frame->index = stats_.delivered++;
+    Seen(frame->frame_id);
     last_frame_time_ = Clock::now();
   }
 
@@ -282,6 +310,10 @@ std::string AravisSource::LastError() const {
 }
 std::uint64_t AravisSource::FrameIdWrap() const {
   return impl_->FrameIdWrap();
+}
+
+int AravisSource::WaitingFrames() const {
+  return impl_->WaitingFrames();
 }
 
 }  // namespace linetrack

@@ -18,17 +18,21 @@ struct AravisSourceOptions {
   // a GigE camera; empty = the first camera found. "Fake_1" opens Aravis' in-process fake
   // camera (the "Fake" interface is enabled for it).
   std::string device_id;
-  std::string pixel_format;           // GenICam name ("Mono8", "BayerRG8", "RGB8", ...); "" = keep
-  int width = 0;                      // pixels; 0 = keep (region set from offset 0,0)
-  int height = 0;                     // pixels; 0 = keep
-  double frame_rate = 0.0;            // frames/s; 0 = keep
-  double exposure_us = 0.0;           // microseconds; 0 = keep
-  double gain = std::nan("");         // camera gain units (often dB); NaN = keep
-  int packet_size = 0;                // GigE stream packet bytes; 0 = keep, -1 = negotiate (auto)
-  int n_buffers = 8;                  // buffers in the stream pool
-  double grab_timeout_s = 0.5;        // longest a Grab() call waits
-  double loss_timeout_s = 1.0;        // no complete frame for this long: the camera is lost
-  double reconnect_backoff_s = 0.25;  // first wait between re-open attempts
+  std::string pixel_format;    // GenICam name ("Mono8", "BayerRG8", "RGB8", ...); "" = keep
+  int width = 0;               // pixels; 0 = keep (region set from offset 0,0)
+  int height = 0;              // pixels; 0 = keep
+  double frame_rate = 0.0;     // frames/s; 0 = keep
+  double exposure_us = 0.0;    // microseconds; 0 = keep
+  double gain = std::nan("");  // camera gain units (often dB); NaN = keep
+  int packet_size = 0;         // GigE stream packet bytes; 0 = keep, -1 = negotiate (auto)
+  int n_buffers = 8;           // buffers in the stream pool
+  // Deliver the newest complete frame: older frames still queued when Grab() is called are
+  // skipped (SourceStats::skipped). For control loops slower than the camera, which would
+  // otherwise work on frames up to n_buffers periods old. Off: every frame, in order.
+  bool latest_only = false;
+  double grab_timeout_s = 0.5;           // longest a Grab() call waits
+  double loss_timeout_s = 1.0;           // no complete frame for this long: the camera is lost
+  double reconnect_backoff_s = 0.25;     // first wait between re-open attempts
   double reconnect_backoff_max_s = 4.0;  // the wait doubles up to this
 
   // False with *why set when a value is out of range (names the field).
@@ -61,6 +65,10 @@ class AravisSource : public FrameSource {
 
   // Wrap of the device's frame ids (65535 for GigE Vision and the fake camera, 0 = none).
   std::uint64_t FrameIdWrap() const;
+
+  // Frames received and waiting for Grab() (0 while the camera is lost): how far behind the
+  // consumer is.
+  int WaitingFrames() const;
 
  private:
   class Impl;

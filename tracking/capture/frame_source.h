@@ -38,7 +38,8 @@ struct Frame {
 // Counters a source keeps over its lifetime.
 struct SourceStats {
   std::int64_t delivered = 0;           // frames returned with kOk
-  std::int64_t missed = 0;              // frames skipped according to the device's frame ids
+  std::int64_t missed = 0;              // frames lost before delivery, from the device's frame ids
+  std::int64_t skipped = 0;             // frames received but passed over for a newer one
   std::int64_t incomplete = 0;          // buffers dropped because the device marked them bad
   std::int64_t timeouts = 0;            // Grab() calls that returned kTimeout
   std::int64_t losses = 0;              // times the device was declared lost
