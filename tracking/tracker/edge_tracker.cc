@@ -186,6 +186,9 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
     for (; passes < settings_.passes; ++passes) {
       const bool last = passes + 1 == settings_.passes;
       tracker_->setProjectionErrorComputation(last);
+      tracker_->setMaxIter(static_cast<unsigned>(last || settings_.first_passes_max_iterations == 0
+                                                     ? settings_.max_iterations
+                                                     : settings_.first_passes_max_iterations));
       tracker_->setDisplayFeatures(last);
       tracker_->setCovarianceComputation(last && with_covariance);
       tracker_->track(image);
