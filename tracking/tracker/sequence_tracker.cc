@@ -64,6 +64,10 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
     *why = "projection error jump: ratio > 1, floor >= 0, window >= 1";
     return false;
   }
+  if (!(rms_jump_ratio > 1.0) || !(rms_jump_floor_px >= 0.0)) {
+    *why = "refinement residual jump: ratio > 1, floor >= 0";
+    return false;
+  }
   if (!(prediction_min_px >= 0.0)) {
     *why = "prediction threshold must be >= 0 px";
     return false;
@@ -110,6 +114,18 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
       problem = text;
     }
   }
+  if (problem.empty() && robot && result.health.refined &&
+      recent_refined_rms_.size() * 3 >= static_cast<size_t>(options_.jump_window)) {
+    const double median = Median(recent_refined_rms_);
+    const double limit = std::max(options_.rms_jump_ratio * median, options_.rms_jump_floor_px);
+    if (result.health.refined_rms_after_px > limit) {
+      char text[128];
+      std::snprintf(text, sizeof(text),
+                    "the image edges fit worse: refinement residual %.2f px (recent median %.2f)",
+                    result.health.refined_rms_after_px, median);
+      problem = text;
+    }
+  }
   if (problem.empty() && last_good_) {
     problem = MotionProblem(last_good_->cam_from_world, result.cam_from_world, t - last_good_->t,
                             options_.motion);
@@ -125,6 +141,9 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
     recent_projection_errors_.pop_front();
+  if (result.health.refined) recent_refined_rms_.push_back(result.health.refined_rms_after_px);
+  while (recent_refined_rms_.size() > static_cast<size_t>(options_.jump_window))
+    recent_refined_rms_.pop_front();
   last_good_index_ = frame_index_;
   report->cam_from_world = result.cam_from_world;
   report->source = source;

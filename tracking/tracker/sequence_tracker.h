@@ -61,6 +61,14 @@ struct SequenceTrackerOptions {
   double jump_ratio = 3.0;
   double jump_floor_deg = 8.0;
   int jump_window = 15;
+  // Likewise, for a robot, the sub-pixel refinement's residual (rms_after): the model edges
+  // fitting the image edges more than rms_jump_ratio times worse than over the last jump_window
+  // good frames (and worse than rms_jump_floor_px) means some latched onto unmodelled lines and
+  // pulled the pose (hall at 30 frames/s: 0.53 px after 0.20, 6.6 cm off). A ratio of 2 also
+  // catches the bench servo drive's 5-9 cm poses (0.30-0.50 px after 0.13-0.19) but drops good
+  // poses of the live drive test (0.34-0.42 px after 0.16-0.19): docs/tracking.md.
+  double rms_jump_ratio = 2.5;
+  double rms_jump_floor_px = 0.3;
 
   bool Check(std::string* why) const;
 };
@@ -147,6 +155,7 @@ class SequenceTracker {
   std::optional<Pose3Dof> initial_prior_;
   std::optional<GoodPose> last_good_;
   std::deque<double> recent_projection_errors_;  // of the last good frames
+  std::deque<double> recent_refined_rms_;        // refinement residuals of the last good frames
   bool following_ = false;  // the tracker holds a good pose from the previous frame
   long frame_index_ = -1;   // frames processed - 1
   long last_good_index_ = -1;
