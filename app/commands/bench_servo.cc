@@ -28,6 +28,10 @@ struct BenchServoCommandOptions {
   bool json = false;
 };
 
+double PassesPerFrame(const ServoBenchRun& r) {
+  return r.frames > 0 ? static_cast<double>(r.tracking_passes) / r.frames : 0.0;
+}
+
 nlohmann::ordered_json ToJson(const ServoBenchRun& r) {
   return {{"run", r.name},
           {"frames", r.frames},
@@ -45,7 +49,14 @@ nlohmann::ordered_json ToJson(const ServoBenchRun& r) {
           {"loop_ms_p95", Quantile(r.loop_ms, 0.95)},
           {"loop_ms_max", Quantile(r.loop_ms, 1.0)},
           {"estimate_ms_median", Quantile(r.estimate_ms, 0.5)},
-          {"capture_ms_median", Quantile(r.grab_ms, 0.5)}};
+          {"capture_ms_median", Quantile(r.grab_ms, 0.5)},
+          {"tracker_stages_ms_median",
+           {{"undistort", Quantile(r.undistort_ms, 0.5)},
+            {"predict", Quantile(r.predict_ms, 0.5)},
+            {"passes", Quantile(r.passes_ms, 0.5)},
+            {"measure", Quantile(r.measure_ms, 0.5)},
+            {"relocalize", Quantile(r.relocalize_ms, 0.5)}}},
+          {"tracking_passes_per_frame", PassesPerFrame(r)}};
 }
 
 int RunBenchServo(BenchServoCommandOptions opt) {
@@ -91,6 +102,13 @@ int RunBenchServo(BenchServoCommandOptions opt) {
          << Quantile(r.loop_ms, 0.5) << " ms, 95% " << Quantile(r.loop_ms, 0.95) << " ms, max "
          << Quantile(r.loop_ms, 1.0) << " ms; estimate median " << Quantile(r.estimate_ms, 0.5)
          << " ms; capture (render) median " << Quantile(r.grab_ms, 0.5) << " ms\n";
+    if (!r.passes_ms.empty()) {
+      text << "  tracker stages, medians: undistortion " << Quantile(r.undistort_ms, 0.5)
+           << " ms, odometry prediction " << Quantile(r.predict_ms, 0.5) << " ms, ViSP passes "
+           << Quantile(r.passes_ms, 0.5) << " ms (" << PassesPerFrame(r)
+           << " per frame), measure and refinement " << Quantile(r.measure_ms, 0.5)
+           << " ms; re-localisation 95% " << Quantile(r.relocalize_ms, 0.95) << " ms\n";
+    }
     text << "  true target error: start " << r.start_error_px << " px, below 2 px at "
          << r.convergence_s << " s, final " << r.final_error_px << " px; after " << r.settle_s
          << " s mean " << r.mean_error_px << ", 95% " << r.p95_error_px << ", max "

@@ -23,6 +23,7 @@ struct BenchTrackOptions {
   int passes = 0;                 // 0: the settings' own
   double pass_step_factor = 0.0;  // 0: the settings' own
   bool no_refinement = false;
+  int first_passes_iterations = -1;  // < 0: the settings' own
   bool json = false;
 };
 
@@ -53,6 +54,9 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
     if (opt.passes > 0) s.settings.passes = opt.passes;
     if (opt.pass_step_factor > 0.0) s.settings.pass_step_factor = opt.pass_step_factor;
     if (opt.no_refinement) s.settings.refine_subpixel = false;
+    if (opt.first_passes_iterations >= 0) {
+      s.settings.first_passes_max_iterations = opt.first_passes_iterations;
+    }
     const TrackBenchResult r = RunTrackBench(s, opt.repeats);
     const double visp_median = Quantile(r.visp_ms, 0.5);
     const double ours_median = Quantile(r.linetrack_ms, 0.5);
@@ -71,7 +75,9 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
                     {"replay_fps", r.replay_fps},
                     {"passes_per_frame", r.replay_passes},
                     {"visp_tracked", r.visp_tracked},
-                    {"linetrack_tracked", r.linetrack_tracked}});
+                    {"linetrack_tracked", r.linetrack_tracked},
+                    {"passes_ms_median", Quantile(r.passes_ms, 0.5)},
+                    {"measure_ms_median", Quantile(r.measure_ms, 0.5)}});
     if (!opt.json) {
       std::cout << std::left << std::setw(23) << r.name << std::right << std::setw(6) << r.frames
                 << std::setw(8) << visp_median << std::setw(7) << Quantile(r.visp_ms, 0.9)
@@ -79,7 +85,10 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
                 << Quantile(r.linetrack_ms, 0.9) << std::setw(7) << ours_cpu << std::setw(8)
                 << ratio << std::setw(8) << std::setprecision(0) << r.replay_fps
                 << std::setprecision(2) << std::setw(8) << r.replay_passes << "  " << r.visp_tracked
-                << "/" << r.linetrack_tracked << "\n";
+                << "/" << r.linetrack_tracked << "\n"
+                << "    linetrack stages, wall medians: ViSP passes " << Quantile(r.passes_ms, 0.5)
+                << " ms, moving-edge states and refinement " << Quantile(r.measure_ms, 0.5)
+                << " ms\n";
     }
   }
   std::error_code ec;
@@ -105,6 +114,8 @@ void AddBenchTrack(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--passes", opt->passes, "Override the minimum tracking passes per frame");
   cmd->add_option("--pass-step-factor", opt->pass_step_factor,
                   "Override the sample step factor of each pass");
+  cmd->add_option("--first-passes-iterations", opt->first_passes_iterations,
+                  "Override the ViSP iterations of every pass but the last (0: all the same)");
   cmd->add_flag("--no-refinement", opt->no_refinement, "Skip the sub-pixel refinement");
   cmd->add_flag("--json", opt->json, "Print the table as JSON");
   cmd->callback([opt, action] { *action = [opt] { return RunBenchTrack(*opt); }; });

@@ -202,8 +202,10 @@ TEST_F(LiveCli, RecordedFramesAndAPtuOverItsSerialLine) {
     with_pose += f[3] == "tracking" || f[3] == "relocalised";
     velocity += f[9] == "velocity";
   }
-  // The tracker's own gates may drop a frame of this turning start (19 of 20 here).
-  EXPECT_GE(with_pose, 18);
+  // The tracker's own gates drop frames of this turning start (2 or 3 of 20): one is refused
+  // by the refinement residual's jump gate, whose pose would be 6.6 cm off
+  // (tests/tracking/hall_test.cc, TurningStartAtThirtyFramesPerSecondReportsNoWrongPose).
+  EXPECT_GE(with_pose, 17);
   EXPECT_GT(velocity, 0);
   EXPECT_FALSE(fs::exists(out_ / "truth.txt"));  // no truth for real devices
   const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));

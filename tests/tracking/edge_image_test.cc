@@ -1,9 +1,11 @@
 // Image-level parts of the tracker, from known ground truth: undistortion of a rendered distorted
 // view, the sub-pixel edge locator on steps at known positions, the pose refinement on the edges
-// of a rendered hall view from a perturbed start, the alignment of a prediction.
+// of a rendered hall view from a perturbed start and with an edge on an unmodelled parallel line,
+// the alignment of a prediction, the RMS image motion of the model between two poses.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -11,6 +13,7 @@
 #include "models/occlusion.h"
 #include "models/render/scene_renderer.h"
 #include "tracking/tracker/edge_refinement.h"
+#include "tracking/tracker/edge_tracker.h"
 #include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -23,6 +26,7 @@ constexpr double kMaxStepErrorPx = 0.1;           // sub-pixel locator on a clea
 constexpr double kMaxUndistortedGreyError = 2.0;  // mean grey-level difference, interior
 constexpr double kRefinedPositionTolM = 0.01;
 constexpr double kRefinedRotationTolDeg = 0.1;
+constexpr double kMotionTolPx = 1e-9;  // RmsImageMotionPx against the pinhole formula
 
 // A vertical step from 50 to 150 grey levels centred at column `edge` (a one-pixel linear ramp,
 // as an anti-aliased edge looks).
@@ -157,6 +161,97 @@ TEST(EdgeRefinement, AlignsAPredictionSeveralPixelsOff) {
   ASSERT_TRUE(aligned.applied);
   EXPECT_LT(ComparePoses(aligned.cam_from_world, truth).translation, kRefinedPositionTolM);
   EXPECT_LT(RadToDeg(ComparePoses(aligned.cam_from_world, truth).rotation), kRefinedRotationTolDeg);
+}
+
+// One vertical model edge whose image step is moved 1.6 px sideways (an unmodelled parallel line,
+// as the outer border of a door casing) and its sites put there: the refinement from the true
+// pose sets that edge aside and stays on the truth; without rejections it is pulled off.
+TEST(EdgeRefinement, SetsAsideAnEdgeOnAnUnmodelledParallelLine) {
+  constexpr double kShiftPx = 1.6;
+  const HallView hall;
+  vpImage<unsigned char> image = hall.Render(false);
+  const Eigen::Isometry3d truth = CamFromWorld(hall.pose);
+  const CameraIntrinsics camera = hall.camera.Undistorted();
+  std::vector<Segment3> edges;
+  for (const ModelEdge& e : hall.model.edges())
+    edges.push_back(e.segment);
+  const OcclusionTester occlusion(hall.model);
+  const std::vector<ProjectedEdge> visible =
+      ProjectVisibleEdges(hall.model, occlusion, truth, camera);
+  // The longest nearly vertical edge in view.
+  const ProjectedEdge* moved = nullptr;
+  for (const ProjectedEdge& e : visible) {
+    const Eigen::Vector2d d = (e.image.b - e.image.a).normalized();
+    if (std::abs(d.y()) > 0.95 && (!moved || e.image.Length() > moved->image.Length())) moved = &e;
+  }
+  ASSERT_NE(moved, nullptr);
+  ASSERT_GT(moved->image.Length(), 100.0);
+  const Eigen::Vector2d a = moved->image.a, d = (moved->image.b - a).normalized();
+  const Eigen::Vector2d n(-d.y(), d.x());
+  const vpImage<unsigned char> original = image;
+  for (unsigned v = 0; v < image.getHeight(); ++v) {
+    for (unsigned u = 0; u < image.getWidth(); ++u) {
+      const Eigen::Vector2d p(u, v);
+      const double s = (p - a).dot(n), along = (p - a).dot(d);
+      if (s < 0.0 || s >= kShiftPx || along < 0.0 || along > moved->image.Length()) continue;
+      const Eigen::Vector2d from = p - 3.0 * n;  // the far side of the step, carried over
+      image[v][u] = original[static_cast<unsigned>(std::lround(from.y()))]
+                            [static_cast<unsigned>(std::lround(from.x()))];
+    }
+  }
+  std::vector<Eigen::Vector2d> sites;
+  for (const ProjectedEdge& e : visible) {
+    const double length = e.image.Length();
+    for (double s = 6.0; s < length - 6.0; s += 8.0) {
+      const Eigen::Vector2d p = e.image.a + s / length * (e.image.b - e.image.a);
+      sites.push_back(&e == moved ? Eigen::Vector2d(p + kShiftPx * n)
+                                  : Eigen::Vector2d(std::round(p.x()), std::round(p.y())));
+    }
+  }
+  const KnownHeightTilt known{hall.pose.height, hall.pose.tilt};
+  const EdgeRefinement kept = RefineOnEdges(image, camera, edges, sites, truth, {}, known);
+  ASSERT_TRUE(kept.applied);
+  EXPECT_GE(kept.rejected_edges, 1);
+  EXPECT_LT(ComparePoses(kept.cam_from_world, truth).translation, kRefinedPositionTolM);
+  EXPECT_LT(RadToDeg(ComparePoses(kept.cam_from_world, truth).rotation), kRefinedRotationTolDeg);
+  EXPECT_GT(kept.position_sigma_m, 0.0);
+  EXPECT_LT(kept.position_sigma_m, kRefinedPositionTolM);
+  EdgeRefinementOptions no_rejection;
+  no_rejection.max_edge_rejections = 0;
+  const EdgeRefinement pulled =
+      RefineOnEdges(image, camera, edges, sites, truth, no_rejection, known);
+  ASSERT_TRUE(pulled.applied);
+  EXPECT_EQ(pulled.rejected_edges, 0);
+  EXPECT_GT(ComparePoses(pulled.cam_from_world, truth).translation,
+            ComparePoses(kept.cam_from_world, truth).translation);
+  std::printf("moved edge of %.0f px: kept %d edges out, %.2f mm; without rejection %.2f mm\n",
+              moved->image.Length(), kept.rejected_edges,
+              1000.0 * ComparePoses(kept.cam_from_world, truth).translation,
+              1000.0 * ComparePoses(pulled.cam_from_world, truth).translation);
+}
+
+// A sideways camera step dx in front of a fronto-parallel edge at depth z moves both ends of its
+// image by px * dx / z; an end behind the camera is infinite motion, nothing in view none.
+TEST(RmsImageMotion, MatchesThePinholeFormula) {
+  CameraIntrinsics camera;
+  camera.px = camera.py = 500.0;
+  camera.u0 = 320.0;
+  camera.v0 = 240.0;
+  camera.width = 640;
+  camera.height = 480;
+  // World = camera frame at `from`: an edge 4 m ahead, 0.4 m long, centred.
+  const std::vector<Segment3> edges{
+      {Eigen::Vector3d(-0.2, 0.1, 4.0), Eigen::Vector3d(0.2, 0.1, 4.0)}};
+  const Eigen::Isometry3d from = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d to = from;
+  to.pretranslate(Eigen::Vector3d(0.08, 0.0, 0.0));  // points move +8 cm in the camera frame
+  EXPECT_NEAR(RmsImageMotionPx(edges, camera, from, to), 500.0 * 0.08 / 4.0, kMotionTolPx);
+  Eigen::Isometry3d behind = from;
+  behind.pretranslate(Eigen::Vector3d(0.0, 0.0, -5.0));
+  EXPECT_TRUE(std::isinf(RmsImageMotionPx(edges, camera, from, behind)));
+  Eigen::Isometry3d away = from;
+  away.prerotate(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()));  // looking the other way
+  EXPECT_EQ(RmsImageMotionPx(edges, camera, away, from), 0.0);
 }
 
 }  // namespace

@@ -14,8 +14,9 @@ namespace {
 
 constexpr double kConvergedPx = 2.0;
 
-ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig, int frames,
-                     double settle_seconds) {
+// `tracker` (null with the simulator's truth) is the rig's estimator, for its stage times.
+ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig,
+                     const TrackerPoseEstimator* tracker, int frames, double settle_seconds) {
   ServoBenchRun run;
   run.name = name;
   run.settle_s = settle_seconds;
@@ -27,6 +28,15 @@ ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig, int frames,
     run.loop_ms.push_back(it.loop_ms);
     run.estimate_ms.push_back(it.estimate_ms);
     run.grab_ms.push_back(it.grab_ms);
+    if (tracker) {
+      const FrameReport& report = tracker->last_report();
+      run.undistort_ms.push_back(report.undistort_ms);
+      run.predict_ms.push_back(report.predict_ms);
+      run.passes_ms.push_back(report.passes_ms);
+      run.measure_ms.push_back(report.measure_ms);
+      run.relocalize_ms.push_back(report.relocalize_ms);
+      run.tracking_passes += report.health.passes;
+    }
     if (it.estimate.has_pose()) {
       ++run.frames_with_pose;
       const PoseDifference d =
@@ -100,7 +110,7 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     const auto tracker = MakeTracker();
     SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
                          options.jitter, tracker.get());
-    runs.push_back(RunOne("still", &rig,
+    runs.push_back(RunOne("still", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.still_seconds * options.fps)),
                           options.still_seconds / 2));
   }
@@ -112,7 +122,7 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     const auto tracker = MakeTracker();
     SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
                          options.jitter, tracker.get());
-    runs.push_back(RunOne("drive", &rig,
+    runs.push_back(RunOne("drive", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.drive_seconds * options.fps)),
                           options.settle_seconds));
   }

@@ -55,6 +55,10 @@ struct ServoBenchRun {
   double max_position_error_m = 0.0;  // estimated pose against the truth (frames with a pose)
   double max_rotation_error_deg = 0.0;
   std::vector<double> grab_ms;  // capture (rendering), not in loop_ms
+  // With the tracker, its stages per frame (FrameReport): undistortion, odometry prediction,
+  // ViSP's passes, measurement and refinement, re-localisation; and the passes run.
+  std::vector<double> undistort_ms, predict_ms, passes_ms, measure_ms, relocalize_ms;
+  int tracking_passes = 0;
 };
 
 // Runs both scenarios on `model` with `camera` (its size is the frame size). `area` is needed

@@ -1,6 +1,7 @@
 #include "tracking/tracker/edge_refinement.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 
@@ -14,6 +15,9 @@ namespace {
 constexpr double kNearClip = 0.05;   // metres
 constexpr double kSampleStep = 0.5;  // pixels between samples of the edge profile
 constexpr double kJacobianStep = 1e-6;
+// The edge profile extends this far beyond the search window on each side, so that the flanks of
+// a blurred step whose peak lies near the window's end are inside it (pixels).
+constexpr double kProfileMarginPx = 1.0;
 
 // Bilinear interpolation; false outside the image.
 bool Bilinear(const vpImage<unsigned char>& image, const Eigen::Vector2d& p, double* value) {
@@ -103,7 +107,66 @@ class PoseParameters {
   Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
 };
 
-// Iteratively reweighted Gauss-Newton on the point-to-line distances of the edge points.
+// Iteratively reweighted Gauss-Newton (Huber weights) on the point-to-line distances of the edge
+// points of `edges`, from the parameters `p` (updated). `r` receives the residuals at the result
+// and `information` J^T W J there. False when an edge falls behind the camera or a step fails.
+bool SolveIrls(const std::vector<ViewedEdge>& edges, const CameraIntrinsics& camera,
+               const PoseParameters& parameters, const EdgeRefinementOptions& options,
+               Eigen::VectorXd* p, Eigen::VectorXd* r, Eigen::MatrixXd* information) {
+  const int dof = parameters.size();
+  const int n = static_cast<int>(r->size());
+  Eigen::VectorXd r_step(n), w(n);
+  Eigen::MatrixXd jacobian(n, dof);
+  auto linearise = [&]() {
+    for (int j = 0; j < dof; ++j) {
+      Eigen::VectorXd stepped = *p;
+      stepped[j] += kJacobianStep;
+      if (!Residuals(edges, camera, parameters.Pose(stepped), &r_step)) return false;
+      jacobian.col(j) = (r_step - *r) / kJacobianStep;
+    }
+    for (int i = 0; i < n; ++i) {
+      const double a = std::abs((*r)[i]);
+      w[i] = a <= options.huber_px ? 1.0 : options.huber_px / a;
+    }
+    *information = jacobian.transpose() * w.asDiagonal() * jacobian;
+    return true;
+  };
+  if (!Residuals(edges, camera, parameters.Pose(*p), r)) return false;
+  for (int it = 0; it < options.iterations; ++it) {
+    if (!linearise()) return false;
+    const Eigen::VectorXd g = jacobian.transpose() * w.asDiagonal() * *r;
+    const Eigen::VectorXd delta = -information->ldlt().solve(g);
+    if (!delta.allFinite()) return false;
+    *p += delta;
+    if (!Residuals(edges, camera, parameters.Pose(*p), r)) return false;
+  }
+  return linearise();
+}
+
+// Mean signed residual of each edge's points (pixels), in the order of `edges`.
+std::vector<double> EdgeMeanResiduals(const std::vector<ViewedEdge>& edges,
+                                      const Eigen::VectorXd& r) {
+  std::vector<double> means;
+  int k = 0;
+  for (const ViewedEdge& e : edges) {
+    const int m = static_cast<int>(e.points.size());
+    means.push_back(r.segment(k, m).mean());
+    k += m;
+  }
+  return means;
+}
+
+int PointCount(const std::vector<ViewedEdge>& edges) {
+  int n = 0;
+  for (const ViewedEdge& e : edges)
+    n += static_cast<int>(e.points.size());
+  return n;
+}
+
+// Refines `start` on the edge points: iteratively reweighted Gauss-Newton, then edge by edge the
+// edge whose points lie on average farthest from it (beyond edge_outlier_px: its points are on an
+// unmodelled parallel line, e.g. the outer border of a door casing) is set aside and the pose
+// solved again. Per-point weights cannot do this: all the points of such an edge agree.
 EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraIntrinsics& camera,
                                  const Eigen::Isometry3d& start,
                                  const std::optional<KnownHeightTilt>& known,
@@ -114,47 +177,45 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   for (ViewedEdge& e : viewed) {
     if (!e.points.empty()) used.push_back(std::move(e));
   }
-  int n = 0;
-  for (const ViewedEdge& e : used)
-    n += static_cast<int>(e.points.size());
-  out.points = n;
-  if (n < options.min_points) return out;
+  out.points = PointCount(used);
+  if (out.points < options.min_points) return out;
 
   const PoseParameters parameters(start, known);
   const int dof = parameters.size();
-  Eigen::VectorXd p = Eigen::VectorXd::Zero(dof);
-  Eigen::VectorXd r(n), r_step(n);
-  Eigen::MatrixXd jacobian(n, dof);
+  Eigen::VectorXd r(out.points);
   if (!Residuals(used, camera, start, &r)) return out;
   out.rms_before_px = Rms(r);
-  const double cost_before = WeightedCost(r, options.huber_px);
-  Eigen::Isometry3d pose = parameters.Pose(p);
-  if (!Residuals(used, camera, pose, &r)) return out;
-  // With a known height and tilt the start may lie off the constraint: compare with its image on
-  // the constraint instead.
-  const double reference_cost = known ? WeightedCost(r, options.huber_px) : cost_before;
-  for (int it = 0; it < options.iterations; ++it) {
-    for (int j = 0; j < dof; ++j) {
-      Eigen::VectorXd stepped = p;
-      stepped[j] += kJacobianStep;
-      if (!Residuals(used, camera, parameters.Pose(stepped), &r_step)) return out;
-      jacobian.col(j) = (r_step - r) / kJacobianStep;
+
+  Eigen::VectorXd p;
+  Eigen::MatrixXd information;
+  for (int rejections = 0;; ++rejections) {
+    const int n = PointCount(used);
+    if (n < options.min_points) return out;
+    p = Eigen::VectorXd::Zero(dof);
+    r.resize(n);
+    if (!SolveIrls(used, camera, parameters, options, &p, &r, &information)) return out;
+    if (rejections == options.max_edge_rejections) break;
+    const std::vector<double> means = EdgeMeanResiduals(used, r);
+    int worst = -1;
+    for (size_t e = 0; e < means.size(); ++e) {
+      if (std::abs(means[e]) > options.edge_outlier_px &&
+          (worst < 0 || std::abs(means[e]) > std::abs(means[worst]))) {
+        worst = static_cast<int>(e);
+      }
     }
-    Eigen::VectorXd w(n);
-    for (int i = 0; i < n; ++i) {
-      const double a = std::abs(r[i]);
-      w[i] = a <= options.huber_px ? 1.0 : options.huber_px / a;
-    }
-    const Eigen::MatrixXd h = jacobian.transpose() * w.asDiagonal() * jacobian;
-    const Eigen::VectorXd g = jacobian.transpose() * w.asDiagonal() * r;
-    const Eigen::VectorXd delta = -h.ldlt().solve(g);
-    if (!delta.allFinite()) return out;
-    p += delta;
-    pose = parameters.Pose(p);
-    if (!Residuals(used, camera, pose, &r)) return out;
+    if (worst < 0) break;
+    out.rejected_points += static_cast<int>(used[worst].points.size());
+    ++out.rejected_edges;
+    used.erase(used.begin() + worst);
   }
+  const Eigen::Isometry3d pose = parameters.Pose(p);
   out.rms_after_px = Rms(r);
-  if (!(WeightedCost(r, options.huber_px) <= reference_cost)) return out;
+  // The kept points must fit better than at the start (with a known height and tilt the start
+  // may lie off the constraint: its image on the constraint instead).
+  Eigen::VectorXd r_start(r.size());
+  const Eigen::Isometry3d reference = known ? parameters.Pose(Eigen::VectorXd::Zero(dof)) : start;
+  if (!Residuals(used, camera, reference, &r_start)) return out;
+  if (!(WeightedCost(r, options.huber_px) <= WeightedCost(r_start, options.huber_px))) return out;
   // Refuse large corrections: they mean the edge points were not where they were looked for.
   double motion = 0.0;
   for (const ViewedEdge& e : used) {
@@ -164,6 +225,17 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   if (!(motion / (2.0 * used.size()) <= options.max_correction_px)) return out;
   out.applied = true;
   out.cam_from_world = pose;
+  out.points = PointCount(used);
+  // Standard deviations from the Gauss-Newton information and the residuals' scale.
+  const double scale2 = r.squaredNorm() / std::max(1, static_cast<int>(r.size()) - dof);
+  const Eigen::MatrixXd covariance = scale2 * information.inverse();
+  if (known && covariance.allFinite()) {
+    out.position_sigma_m = std::sqrt(std::max(
+        0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance.topLeftCorner<2, 2>())
+                 .eigenvalues()
+                 .maxCoeff()));
+    out.heading_sigma_rad = std::sqrt(std::max(0.0, covariance(2, 2)));
+  }
   return out;
 }
 
@@ -173,6 +245,10 @@ bool EdgeRefinementOptions::Check(std::string* why) const {
   if (!(association_px > 0.0) || !(ambiguity_px >= association_px) || !(end_margin_px >= 0.0) ||
       !(search_px >= 1.0 && search_px <= 10.0)) {
     *why = "edge refinement: association > 0, ambiguity >= association, search in [1, 10] px";
+    return false;
+  }
+  if (!(edge_outlier_px > 0.0) || max_edge_rejections < 0) {
+    *why = "edge refinement: edge outlier distance > 0, rejections >= 0";
     return false;
   }
   if (!(min_gradient > 0.0) || !(huber_px > 0.0) || iterations < 1 || min_points < 6 ||
@@ -199,7 +275,7 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
                           const Eigen::Vector2d& normal, double search_px, double min_gradient) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const Eigen::Vector2d tangent(-normal.y(), normal.x());
-  const int half = static_cast<int>(std::ceil(search_px / kSampleStep)) + 1;
+  const int half = static_cast<int>(std::ceil((search_px + kProfileMarginPx) / kSampleStep)) + 1;
   std::vector<double> profile(2 * half + 1);
   for (int k = -half; k <= half; ++k) {
     double sum = 0.0;

@@ -27,6 +27,10 @@ struct EdgeRefinementOptions {
   int iterations = 5;              // Gauss-Newton iterations
   int min_points = 20;             // fewer edge points: the pose is left as it is
   double max_correction_px = 3.0;  // a larger mean image motion is refused
+  // An edge whose points lie this far from it on average after the solve is set aside (they are
+  // on an unmodelled parallel line) and the pose solved again, at most max_edge_rejections times.
+  double edge_outlier_px = 1.0;
+  int max_edge_rejections = 3;
 
   bool Check(std::string* why) const;
 };
@@ -52,7 +56,13 @@ struct EdgeRefinement {
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // refined (or the start)
   int points = 0;                                                    // edge points used
   double rms_before_px = 0.0;  // point-to-line distances at the start pose
-  double rms_after_px = 0.0;
+  double rms_after_px = 0.0;   // of the points kept
+  int rejected_edges = 0;      // edges set aside (edge_outlier_px) and their points
+  int rejected_points = 0;
+  // With a known height and tilt: standard deviations of the refined position (largest axis,
+  // metres) and heading (radians), from the Gauss-Newton information and the residuals' scale.
+  double position_sigma_m = 0.0;
+  double heading_sigma_rad = 0.0;
 };
 
 // Refines `start` (cam_from_world) so that the model `edges` (world) pass through the sub-pixel

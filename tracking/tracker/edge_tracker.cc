@@ -5,11 +5,15 @@
 #include <visp3/core/vpException.h>
 #include <visp3/mbt/vpMbGenericTracker.h>
 
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "models/errors.h"
+#include "models/geometry.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -18,8 +22,42 @@ namespace {
 
 // ViSP's vpMeSite::NO_SUPPRESSION: a moving edge found and kept.
 constexpr double kGoodSiteState = 0.0;
+constexpr double kNearClip = 0.05;  // metres, for the image motion of the model
+
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
 
 }  // namespace
+
+double RmsImageMotionPx(const std::vector<Segment3>& edges, const CameraIntrinsics& camera,
+                        const Eigen::Isometry3d& from, const Eigen::Isometry3d& to) {
+  double sum = 0.0;
+  int count = 0;
+  for (const Segment3& edge : edges) {
+    Segment3 clipped = edge;
+    if (!ClipToFrustum(from, camera, kNearClip, &clipped)) continue;
+    for (const Eigen::Vector3d& end : {clipped.a, clipped.b}) {
+      const Eigen::Vector3d at_from = from * end, at_to = to * end;
+      if (!(at_to.z() > 0.0)) return std::numeric_limits<double>::infinity();
+      sum += (camera.Project(at_to) - camera.Project(at_from)).squaredNorm();
+      ++count;
+    }
+  }
+  return count > 0 ? std::sqrt(sum / count) : 0.0;
+}
+
+MovingEdgeSites ReadMovingEdgeSites(const std::vector<std::vector<double>>& features) {
+  MovingEdgeSites sites;
+  for (const std::vector<double>& feature : features) {
+    if (feature.size() < 4 || feature[0] != 0.0) continue;  // type 0: a moving edge
+    ++sites.total;
+    if (feature[3] == kGoodSiteState) sites.good.emplace_back(feature[2], feature[1]);
+  }
+  return sites;
+}
 
 vpHomogeneousMatrix ToVispPose(const Eigen::Isometry3d& cam_from_world) {
   vpHomogeneousMatrix cMo;
@@ -143,15 +181,24 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
     return result;
   }
   try {
+    const Clock::time_point start = Clock::now();
     int passes = 0;
     for (; passes < settings_.passes; ++passes) {
       const bool last = passes + 1 == settings_.passes;
       tracker_->setProjectionErrorComputation(last);
+      tracker_->setMaxIter(static_cast<unsigned>(last || settings_.first_passes_max_iterations == 0
+                                                     ? settings_.max_iterations
+                                                     : settings_.first_passes_max_iterations));
+      tracker_->setDisplayFeatures(last);
       tracker_->setCovarianceComputation(last && with_covariance);
       tracker_->track(image);
     }
+    const double passes_ms = MillisecondsSince(start);
+    const Clock::time_point measure_start = Clock::now();
     EdgeTrackResult measured = Measure(image, with_covariance, known);
     measured.health.passes = passes;
+    measured.passes_ms = passes_ms;
+    measured.measure_ms = MillisecondsSince(measure_start);
     return measured;
   } catch (const vpException& e) {
     started_ = false;
@@ -168,24 +215,21 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
   result.visp_cam_from_world = result.cam_from_world;
   TrackHealth& health = result.health;
   health.projection_error_deg = tracker_->getProjectionError();
-  std::vector<Eigen::Vector2d> good_sites;
-  for (const std::vector<double>& feature : tracker_->getFeaturesForDisplay()) {
-    if (feature.size() < 4 || feature[0] != 0.0)
-      continue;  // type 0: a moving edge {0, i, j, state}
-    ++health.edges_total;
-    if (feature[3] != kGoodSiteState) continue;
-    ++health.edges_good;
-    good_sites.emplace_back(feature[2], feature[1]);
-  }
+  const MovingEdgeSites sites = ReadMovingEdgeSites(tracker_->getFeaturesForDisplay());
+  health.edges_total = sites.total;
+  health.edges_good = static_cast<int>(sites.good.size());
   if (settings_.refine_subpixel) {
     const EdgeRefinement refined = RefineOnEdges(
-        image, camera_, edges_, good_sites, result.cam_from_world, settings_.refinement, known);
+        image, camera_, edges_, sites.good, result.cam_from_world, settings_.refinement, known);
     health.refined = refined.applied;
     health.refined_points = refined.points;
     if (refined.applied) {
       result.cam_from_world = refined.cam_from_world;
       health.refined_rms_before_px = refined.rms_before_px;
       health.refined_rms_after_px = refined.rms_after_px;
+      health.refined_rejected_edges = refined.rejected_edges;
+      health.refined_position_sigma_m = refined.position_sigma_m;
+      health.refined_heading_sigma_deg = RadToDeg(refined.heading_sigma_rad);
     }
   }
   if (!with_covariance) return result;

@@ -30,8 +30,17 @@ struct EdgeTrackResult {
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
   // ViSP's own pose before the sub-pixel refinement (equal to cam_from_world without it).
   Eigen::Isometry3d visp_cam_from_world = Eigen::Isometry3d::Identity();
-  TrackHealth health;  // measured by Track() (Start() measures nothing)
+  TrackHealth health;       // measured by Track() (Start() measures nothing)
+  double passes_ms = 0.0;   // Track(): wall clock in ViSP's track() calls
+  double measure_ms = 0.0;  // Track(): projection error read, moving-edge states, refinement,
+                            // covariance
 };
+
+// RMS image motion (pixels) of the model `edges` (world) between two poses: the edges are clipped
+// to the view of `from`, their clipped ends projected under both poses. 0 when no edge is in view;
+// infinite when an end falls behind the camera at `to`.
+double RmsImageMotionPx(const std::vector<Segment3>& edges, const CameraIntrinsics& camera,
+                        const Eigen::Isometry3d& from, const Eigen::Isometry3d& to);
 
 class EdgeTracker {
  public:
@@ -64,6 +73,10 @@ class EdgeTracker {
                                       const Eigen::Isometry3d& predicted,
                                       const std::optional<KnownHeightTilt>& known = std::nullopt);
 
+  // RmsImageMotionPx of this tracker's model edges (undistorted camera).
+  double ImageMotionPx(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to) const {
+    return RmsImageMotionPx(edges_, camera_, from, to);
+  }
   // True after a successful Start() and until a Track() fails.
   bool started() const { return started_; }
 
@@ -82,6 +95,14 @@ class EdgeTracker {
   TrackerSettings settings_;
   bool started_ = false;
 };
+
+// Moving edges after a ViSP track() call (its display features: {0, i, j, state} per site):
+// how many there are, and the image positions (u, v) of the good ones (vpMeSite::NO_SUPPRESSION).
+struct MovingEdgeSites {
+  int total = 0;
+  std::vector<Eigen::Vector2d> good;
+};
+MovingEdgeSites ReadMovingEdgeSites(const std::vector<std::vector<double>>& features);
 
 // cam_from_world <-> ViSP's cMo.
 vpHomogeneousMatrix ToVispPose(const Eigen::Isometry3d& cam_from_world);

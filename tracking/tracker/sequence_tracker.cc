@@ -64,8 +64,12 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
     *why = "projection error jump: ratio > 1, floor >= 0, window >= 1";
     return false;
   }
-  if (!(prediction_min_px >= 0.0) || !(prediction_depth_m > 0.0)) {
-    *why = "prediction threshold must be >= 0 px and its depth > 0 m";
+  if (!(rms_jump_ratio > 1.0) || !(rms_jump_floor_px >= 0.0)) {
+    *why = "refinement residual jump: ratio > 1, floor >= 0";
+    return false;
+  }
+  if (!(prediction_min_px >= 0.0)) {
+    *why = "prediction threshold must be >= 0 px";
     return false;
   }
   return true;
@@ -110,6 +114,18 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
       problem = text;
     }
   }
+  if (problem.empty() && robot && result.health.refined &&
+      recent_refined_rms_.size() * 3 >= static_cast<size_t>(options_.jump_window)) {
+    const double median = Median(recent_refined_rms_);
+    const double limit = std::max(options_.rms_jump_ratio * median, options_.rms_jump_floor_px);
+    if (result.health.refined_rms_after_px > limit) {
+      char text[128];
+      std::snprintf(text, sizeof(text),
+                    "the image edges fit worse: refinement residual %.2f px (recent median %.2f)",
+                    result.health.refined_rms_after_px, median);
+      problem = text;
+    }
+  }
   if (problem.empty() && last_good_) {
     problem = MotionProblem(last_good_->cam_from_world, result.cam_from_world, t - last_good_->t,
                             options_.motion);
@@ -125,6 +141,9 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
     recent_projection_errors_.pop_front();
+  if (result.health.refined) recent_refined_rms_.push_back(result.health.refined_rms_after_px);
+  while (recent_refined_rms_.size() > static_cast<size_t>(options_.jump_window))
+    recent_refined_rms_.pop_front();
   last_good_index_ = frame_index_;
   report->cam_from_world = result.cam_from_world;
   report->source = source;
@@ -186,10 +205,11 @@ void SequenceTracker::MaybePredict(const std::optional<RobotReading>& robot, Fra
   const Eigen::Isometry3d predicted =
       PredictFromOdometry(last_good_->cam_from_world, WithReading(*then.odometry, then),
                           WithReading(*robot->odometry, *robot));
-  const PoseDifference move = ComparePoses(predicted, last_good_->cam_from_world);
-  const double shift_px =
-      tracker_->camera().px * (move.rotation + move.translation / options_.prediction_depth_m);
-  if (shift_px <= options_.prediction_min_px) return;
+  // The model's own image motion: driving forward or at a distance moves the image little.
+  if (tracker_->ImageMotionPx(last_good_->cam_from_world, predicted) <=
+      options_.prediction_min_px) {
+    return;
+  }
   // Aligned on the edges when they are found, else started from the prediction as it is.
   if (!tracker_->StartFromPrediction(*undistorted_, predicted, Known(robot)).ok) {
     tracker_->Start(*undistorted_, predicted);
@@ -208,8 +228,11 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   if (following_) {
     const Clock::time_point track_start = Clock::now();
     MaybePredict(robot, &report);
+    report.predict_ms = MillisecondsSince(track_start);
     const EdgeTrackResult result = tracker_->Track(*undistorted_, false, Known(robot));
     report.track_ms = MillisecondsSince(track_start);
+    report.passes_ms = result.passes_ms;
+    report.measure_ms = result.measure_ms;
     report.health = result.health;
     report.health_measured = result.ok;
     const std::string problem = Judge(result, t, robot);

@@ -153,6 +153,8 @@ TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats) {
       const FrameReport report = tracker.Process(frames[i], i / 30.0, std::nullopt);
       result.linetrack_cpu_ms.push_back(ThreadCpuMs() - cpu);
       result.linetrack_ms.push_back(MillisecondsSince(start));
+      result.passes_ms.push_back(report.passes_ms);
+      result.measure_ms.push_back(report.measure_ms);
       if (r == 0 && report.status == TrackStatus::kTracking) ++result.linetrack_tracked;
     }
   }

@@ -42,6 +42,9 @@ struct TrackBenchResult {
   // the frames it tracked, linetrack's Process() (undistortion, passes, health) on every frame.
   std::vector<double> visp_ms, visp_cpu_ms;
   std::vector<double> linetrack_ms, linetrack_cpu_ms;
+  // Wall clock of two stages of linetrack's step (FrameReport): ViSP's passes, and the moving-edge
+  // states with the sub-pixel refinement.
+  std::vector<double> passes_ms, measure_ms;
   double replay_fps = 0.0;     // frames / s through decoding and Process(), no encoding
   double replay_passes = 0.0;  // mean tracking passes per frame in the replay run
 };

@@ -69,6 +69,10 @@ bool TrackerSettings::Check(std::string* why) const {
     *why = "max_iterations must be in [1, 1000]";
     return false;
   }
+  if (first_passes_max_iterations < 0 || first_passes_max_iterations > 1000) {
+    *why = "first_passes_max_iterations must be in [0, 1000] (0: max_iterations)";
+    return false;
+  }
   if (!(good_edge_ratio >= 0.0 && good_edge_ratio < 1.0)) {
     *why = "good_edge_ratio must be in [0, 1)";
     return false;

@@ -28,6 +28,11 @@ struct TrackHealth {
   int refined_points = 0;
   double refined_rms_before_px = 0.0;
   double refined_rms_after_px = 0.0;
+  int refined_rejected_edges = 0;  // edges set aside as lying on unmodelled parallel lines
+  // With a robot's known height and tilt: standard deviations of the refined position (largest
+  // horizontal axis, metres) and heading (degrees); 0 otherwise.
+  double refined_position_sigma_m = 0.0;
+  double refined_heading_sigma_deg = 0.0;
 
   double GoodShare() const {
     return edges_total > 0 ? static_cast<double>(edges_good) / edges_total : 0.0;
