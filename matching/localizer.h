@@ -98,6 +98,16 @@ class Localizer {
   const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
+  // An exhausted search may have missed the pose that explains the lines its best pose leaves
+  // unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the
+  // tree is searched again over those lines alone, with fresh budgets, its leaves handed to
+  // `visit` (which verifies them against all lines).
+  void SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const std::vector<double>& caps,
+                              const std::vector<VerifiedPose>& verified, const LeafVisitor& visit,
+                              long* pair_tests, LocalizationResult* result) const;
+
   // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
   // and support checks) and fills `result`.
   void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
