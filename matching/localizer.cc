@@ -193,37 +193,47 @@ void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
                                        const std::vector<VerifiedPose>& verified,
                                        const LeafVisitor& visit, long* pair_tests,
                                        LocalizationResult* result) const {
-  const VerifiedPose* top = nullptr;
-  for (const VerifiedPose& v : verified) {
-    if (v.plausible && (top == nullptr || v.evidence.Score() > top->evidence.Score())) top = &v;
+  // First the lines the best pose does not explain at all; when that finds nothing better, the
+  // lines it does not explain with a reported correspondence (it may hold contested true lines).
+  std::vector<bool> searched;
+  double searched_from = -std::numeric_limits<double>::infinity();
+  for (const bool reported_only : {false, true}) {
+    const VerifiedPose* top = nullptr;
+    for (const VerifiedPose& v : verified) {
+      if (v.plausible && (top == nullptr || v.evidence.Score() > top->evidence.Score())) top = &v;
+    }
+    if (top == nullptr || (reported_only && top->evidence.Score() > searched_from)) return;
+    std::vector<bool> explained(lines.size(), false);
+    for (const auto& pair : reported_only ? top->confident_pairs : top->pairs)
+      explained[pair.second] = true;
+    if (explained == searched) return;
+    searched = explained;
+    searched_from = top->evidence.Score();
+    std::vector<ObservedLine> rest;
+    std::vector<double> rest_caps;
+    for (size_t l = 0; l < lines.size(); ++l) {
+      if (explained[l]) continue;
+      rest.push_back(lines[l]);
+      rest_caps.push_back(caps[l]);
+    }
+    if (static_cast<int>(rest.size()) < options_.tree.min_matches) continue;
+    // Leaves over `rest` are handed on with the line indices of the full list
+    // (ObservedLine::index is the position in it), with a fresh verification budget. `top` may
+    // dangle from here on: the visitor adds to `verified`.
+    *pair_tests = 0;
+    InterpretationTreeStats stats;
+    SearchInterpretationTree(
+        edges, rest, prior, options_.tree, rest_caps,
+        [&](const Hypothesis& h) {
+          Hypothesis full = h;
+          for (auto& pair : full.pairs)
+            pair.second = rest[pair.second].index;
+          return visit(full);
+        },
+        &stats, nullptr);
+    result->tree_nodes += stats.nodes;
+    result->tree_checks += stats.checks;
   }
-  if (top == nullptr) return;
-  std::vector<bool> explained(lines.size(), false);
-  for (const auto& pair : top->pairs)
-    explained[pair.second] = true;
-  std::vector<ObservedLine> rest;
-  std::vector<double> rest_caps;
-  for (size_t l = 0; l < lines.size(); ++l) {
-    if (explained[l]) continue;
-    rest.push_back(lines[l]);
-    rest_caps.push_back(caps[l]);
-  }
-  if (static_cast<int>(rest.size()) < options_.tree.min_matches) return;
-  // Leaves over `rest` are handed on with the line indices of the full list (ObservedLine::index
-  // is the position in it), with a fresh verification budget.
-  *pair_tests = 0;
-  InterpretationTreeStats stats;
-  SearchInterpretationTree(
-      edges, rest, prior, options_.tree, rest_caps,
-      [&](const Hypothesis& h) {
-        Hypothesis full = h;
-        for (auto& pair : full.pairs)
-          pair.second = rest[pair.second].index;
-        return visit(full);
-      },
-      &stats, nullptr);
-  result->tree_nodes += stats.nodes;
-  result->tree_checks += stats.checks;
 }
 
 void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,

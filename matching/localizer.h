@@ -101,7 +101,8 @@ class Localizer {
   // An exhausted search may have missed the pose that explains the lines its best pose leaves
   // unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the
   // tree is searched again over those lines alone, with fresh budgets, its leaves handed to
-  // `visit` (which verifies them against all lines).
+  // `visit` (which verifies them against all lines); when that finds nothing better, over the
+  // lines it does not explain with a reported correspondence.
   void SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
                               const std::vector<ObservedLine>& lines, const PriorRegion& prior,
                               const std::vector<double>& caps,

@@ -197,7 +197,8 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
     for (size_t e = 0; e < images.size(); ++e) {
       const EdgeImage& image = images[e];
       if (!image.visible ||
-          std::max(std::abs(image.line.dot(qa)), std::abs(image.line.dot(qb))) > reject_px[e]) {
+          std::max(std::abs(image.line.dot(qa)), std::abs(image.line.dot(qb))) > reject_px[e] ||
+          context.excluded_pair == std::make_pair(static_cast<int>(e), static_cast<int>(l))) {
         continue;
       }
       Eigen::Matrix<double, 2, 4> j;
@@ -547,17 +548,27 @@ std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
                                             const VerificationOptions& options,
                                             const VerifiedPose& verified) {
   std::vector<VerifiedPose> rivals;
+  // A pair is influential when the pose without it moves beyond the pose's own uncertainty
+  // (Cook's distance: Mahalanobis shift against the chi-square quantile, 3 dof).
+  const Eigen::Matrix3d c = verified.refinement.covariance.topLeftCorner<3, 3>();
+  const double influential = ChiSquareQuantile(3.0, NormalQuantile(options.hypothesis_quantile));
   for (size_t i = 0; i < verified.pairs.size(); ++i) {
     Pose3Dof moved;
     // A pair that alone fixes a direction of the pose (no deleted pose) is always tried.
-    if (DeletedPose(context, verified, i, &moved) && SamePose(moved, verified.pose, options)) {
-      continue;
+    if (DeletedPose(context, verified, i, &moved) && c.determinant() > 0.0) {
+      const Eigen::Vector3d shift(WrapAngle(moved.heading - verified.pose.heading),
+                                  moved.x - verified.pose.x, moved.y - verified.pose.y);
+      if (SamePose(moved, verified.pose, options) &&
+          shift.dot(c.ldlt().solve(shift)) <= influential) {
+        continue;
+      }
     }
     std::vector<std::pair<int, int>> others = verified.pairs;
     others.erase(others.begin() + static_cast<long>(i));
-    VerifiedPose rival =
-        Rematch(context, RefineHypothesis(context, others, {moved}, options), options);
-    if (!SamePose(rival.pose, verified.pose, options)) rivals.push_back(std::move(rival));
+    VerificationContext without = context;
+    without.excluded_pair = verified.pairs[i];
+    rivals.push_back(
+        Rematch(without, RefineHypothesis(context, others, {moved}, options), options));
   }
   return rivals;
 }

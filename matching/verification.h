@@ -90,6 +90,8 @@ struct VerificationContext {
   LineNoise noise;  // line noise and calibration error (focal_relative)
   // When set, counts the (line, visible edge) pairs guided matching tests (the work budget).
   long* pair_tests = nullptr;
+  // When set, a pair (edge index, line index) guided matching may not use (a rival without it).
+  std::pair<int, int> excluded_pair = {-1, -1};
 };
 
 // Evidence for a pose (nats): the log-likelihood ratio of the observed lines under "the camera is
@@ -171,10 +173,11 @@ int OutlyingPair(const VerificationContext& context, const VerificationOptions& 
 bool DeletedPose(const VerificationContext& context, const VerifiedPose& verified, size_t i,
                  Pose3Dof* pose);
 
-// The poses a verified pose's pairs give without one of them, when distinct from it (SamePose):
-// a pose that hinges on a single correspondence has the pose of the others as a rival
-// explanation, which the tree does not verify (a subset of a verified leaf). Each rival is
-// refined from the first-order deleted pose and verified by Rematch (evidence lines term only).
+// The poses a verified pose's pairs give without one of its influential pairs (the first-order
+// deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
+// hypothesis_quantile of chi2(3)), each refined and verified by Rematch without that pair
+// (evidence lines term only). A pose that hinges on one correspondence has the pose of the
+// others as a rival explanation, which the tree does not verify (a subset of a verified leaf).
 std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
                                             const VerificationOptions& options,
                                             const VerifiedPose& verified);
