@@ -11,6 +11,10 @@
 namespace linetrack {
 
 bool LocalizerOptions::Check(std::string* why) const {
+  if (!(unexplained_search_share >= 0.0 && unexplained_search_share <= 1.0)) {
+    *why = "unexplained_search_share: must be in [0, 1]";
+    return false;
+  }
   return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
 }
 
@@ -171,7 +175,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     result.tree_nodes = stats.nodes;
     result.tree_checks = stats.checks;
     result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
-    if (result.budget_exhausted) {
+    if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
       SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
     }
     context.pair_tests = nullptr;
@@ -220,10 +224,16 @@ void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
     // Leaves over `rest` are handed on with the line indices of the full list
     // (ObservedLine::index is the position in it), with a fresh verification budget. `top` may
     // dangle from here on: the visitor adds to `verified`.
-    *pair_tests = 0;
+    const double share = options_.unexplained_search_share;
+    *pair_tests = static_cast<long>((1.0 - share) *
+                                    static_cast<double>(options_.verification.max_pair_tests));
+    InterpretationTreeOptions tree = options_.tree;
+    tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
+    tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
+    tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
     InterpretationTreeStats stats;
     SearchInterpretationTree(
-        edges, rest, prior, options_.tree, rest_caps,
+        edges, rest, prior, tree, rest_caps,
         [&](const Hypothesis& h) {
           Hypothesis full = h;
           for (auto& pair : full.pairs)

@@ -32,6 +32,10 @@ struct LocalizerOptions {
   InterpretationTreeOptions tree;
   BaselineOptions baseline;
   VerificationOptions verification;
+  // Budgets (nodes, checks, leaves, guided-matching pair tests) of each search over the lines an
+  // exhausted search's best pose leaves unexplained, as a share of the main search's (two such
+  // searches at most: the time of a localisation stays within 1 + 2 x this of the budget's).
+  double unexplained_search_share = 0.25;
 
   bool Check(std::string* why) const;
 };
