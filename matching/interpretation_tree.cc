@@ -188,7 +188,8 @@ class TreeSearch {
       if (next < 0) next = j;
     }
     if (distinct_edges_ + open_lines < options_.min_matches ||
-        assigned_caps_ + reachable < Bound() || InBasin(region) || VerifiedAgain(open_lines)) {
+        assigned_caps_ + reachable < Bound() || InBasin(region, assigned_caps_ + reachable) ||
+        VerifiedAgain(open_lines)) {
       return;
     }
     if (next < 0) {
@@ -275,11 +276,12 @@ class TreeSearch {
     return false;
   }
 
-  // True when the region lies in the basin of a verified pose: its leaves are the same answer.
-  bool InBasin(const FeasibleRegion& region) const {
+  // True when the region lies in the basin of a verified pose and its leaves cannot reach that
+  // pose's evidence (`bound`): they would be the same answer, no better.
+  bool InBasin(const FeasibleRegion& region, double bound) const {
     if (basins_ == nullptr) return false;
     return std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
-      return region.Within(b.pose, b.radius_m, b.heading_rad);
+      return bound <= b.evidence && region.Within(b.pose, b.radius_m, b.heading_rad);
     });
   }
 

@@ -68,14 +68,18 @@ struct Hypothesis {
 };
 
 // A pose already verified and what would be verified into it again: subtrees whose region lies
-// in its neighbourhood (radius_m, heading_rad), leaves whose region holds the pose, and subtrees
+// in its neighbourhood (radius_m, heading_rad) unless their bound exceeds its evidence (the
+// verified pose may hold a wrong pair; a better leaf there is a better version of the same
+// answer), leaves whose region holds the pose, and subtrees
 // all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
 // pose) and fewer lines than it explains.
 struct VerifiedBasin {
   Pose3Dof pose;
+  // Its neighbourhood (basin_sigmas standard deviations).
   double radius_m = 0.0;
   double heading_rad = 0.0;
-  int lines = 0;                             // lines the verified pose explains
+  int lines = 0;          // lines the verified pose explains
+  double evidence = 0.0;  // its evidence (nats): a subtree in its basin must be able to beat it
   std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
 };
 

@@ -11,6 +11,10 @@
 namespace linetrack {
 
 bool LocalizerOptions::Check(std::string* why) const {
+  if (!(unexplained_search_share >= 0.0 && unexplained_search_share <= 1.0)) {
+    *why = "unexplained_search_share: must be in [0, 1]";
+    return false;
+  }
   return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
 }
 
@@ -118,61 +122,62 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     std::vector<VerifiedBasin> basins;
     long pair_tests = 0;
     context.pair_tests = &pair_tests;
-    SearchInterpretationTree(
-        edges, lines, prior, options_.tree, caps,
-        [&](const Hypothesis& h) {
-          const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
-          for (const auto& pairs : verified_pairs) {
-            if (std::all_of(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
-                  return std::binary_search(pairs.begin(), pairs.end(), p);
-                })) {
-              return bound;
-            }
-          }
-          // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
-          // explains as many: verified into it again.
-          for (const VerifiedBasin& b : basins) {
-            const int fit =
-                static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
-                  return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
-                }));
-            const int size = static_cast<int>(h.pairs.size());
-            if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
-              return bound;
-            }
-          }
-          if (pair_tests >= vo.max_pair_tests) {
-            result.budget_exhausted = true;
-            return std::numeric_limits<double>::infinity();  // stops the search
-          }
-          ++result.hypotheses;
-          VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
-          if (!TrimHypothesis(context, vo, &leaf) ||
-              HypothesisEvidence(context, vo, leaf) < bound) {
-            return bound;
-          }
-          VerifiedPose v = Rematch(context, leaf, vo);
-          if (v.plausible) {
-            CompleteEvidence(context, vo, &v);
-            best = std::max(best, v.evidence.Score());
-            // Leaves that would be verified into this pose again are not verified: those whose
-            // region holds it or lies within basin_sigmas of its standard deviations, and those
-            // most of whose pairs fit it.
-            basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
-                              vo.basin_sigmas * v.refinement.heading_sigma_rad,
-                              static_cast<int>(v.pairs.size()), FittingPairs(context, vo, v)});
-          }
-          std::vector<std::pair<int, int>> pairs = v.pairs;
-          std::sort(pairs.begin(), pairs.end());
-          verified_pairs.push_back(std::move(pairs));
-          verified.push_back(std::move(v));
-          return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
-        },
-        &stats, &basins);
+    const LeafVisitor visit = [&](const Hypothesis& h) {
+      const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
+      for (const auto& pairs : verified_pairs) {
+        if (std::all_of(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+              return std::binary_search(pairs.begin(), pairs.end(), p);
+            })) {
+          return bound;
+        }
+      }
+      // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
+      // explains as many: verified into it again.
+      for (const VerifiedBasin& b : basins) {
+        const int fit =
+            static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+              return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
+            }));
+        const int size = static_cast<int>(h.pairs.size());
+        if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
+          return bound;
+        }
+      }
+      if (pair_tests >= vo.max_pair_tests) {
+        result.budget_exhausted = true;
+        return std::numeric_limits<double>::infinity();  // stops the search
+      }
+      ++result.hypotheses;
+      VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
+      if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
+        return bound;
+      }
+      VerifiedPose v = Rematch(context, leaf, vo);
+      if (v.plausible) {
+        CompleteEvidence(context, vo, &v);
+        best = std::max(best, v.evidence.Score());
+        // Leaves that would be verified into this pose again are not verified: those whose
+        // region holds it or lies within basin_sigmas of its standard deviations, and those
+        // most of whose pairs fit it.
+        basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
+                          vo.basin_sigmas * v.refinement.heading_sigma_rad,
+                          static_cast<int>(v.pairs.size()), v.evidence.Score(),
+                          FittingPairs(context, vo, v)});
+      }
+      std::vector<std::pair<int, int>> pairs = v.pairs;
+      std::sort(pairs.begin(), pairs.end());
+      verified_pairs.push_back(std::move(pairs));
+      verified.push_back(std::move(v));
+      return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
+    };
+    SearchInterpretationTree(edges, lines, prior, options_.tree, caps, visit, &stats, &basins);
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
     result.tree_checks = stats.checks;
     result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
+    if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
+      SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
+    }
     context.pair_tests = nullptr;
   } else {
     BaselineStats stats;
@@ -184,6 +189,61 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   }
   Decide(std::move(verified), context, edges, &result);
   return result;
+}
+
+void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
+                                       const std::vector<ObservedLine>& lines,
+                                       const PriorRegion& prior, const std::vector<double>& caps,
+                                       const std::vector<VerifiedPose>& verified,
+                                       const LeafVisitor& visit, long* pair_tests,
+                                       LocalizationResult* result) const {
+  // First the lines the best pose does not explain at all; when that finds nothing better, the
+  // lines it does not explain with a reported correspondence (it may hold contested true lines).
+  std::vector<bool> searched;
+  double searched_from = -std::numeric_limits<double>::infinity();
+  for (const bool reported_only : {false, true}) {
+    const VerifiedPose* top = nullptr;
+    for (const VerifiedPose& v : verified) {
+      if (v.plausible && (top == nullptr || v.evidence.Score() > top->evidence.Score())) top = &v;
+    }
+    if (top == nullptr || (reported_only && top->evidence.Score() > searched_from)) return;
+    std::vector<bool> explained(lines.size(), false);
+    for (const auto& pair : reported_only ? top->confident_pairs : top->pairs)
+      explained[pair.second] = true;
+    if (explained == searched) return;
+    searched = explained;
+    searched_from = top->evidence.Score();
+    std::vector<ObservedLine> rest;
+    std::vector<double> rest_caps;
+    for (size_t l = 0; l < lines.size(); ++l) {
+      if (explained[l]) continue;
+      rest.push_back(lines[l]);
+      rest_caps.push_back(caps[l]);
+    }
+    if (static_cast<int>(rest.size()) < options_.tree.min_matches) continue;
+    // Leaves over `rest` are handed on with the line indices of the full list
+    // (ObservedLine::index is the position in it), with a fresh verification budget. `top` may
+    // dangle from here on: the visitor adds to `verified`.
+    const double share = options_.unexplained_search_share;
+    *pair_tests = static_cast<long>((1.0 - share) *
+                                    static_cast<double>(options_.verification.max_pair_tests));
+    InterpretationTreeOptions tree = options_.tree;
+    tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
+    tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
+    tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
+    InterpretationTreeStats stats;
+    SearchInterpretationTree(
+        edges, rest, prior, tree, rest_caps,
+        [&](const Hypothesis& h) {
+          Hypothesis full = h;
+          for (auto& pair : full.pairs)
+            pair.second = rest[pair.second].index;
+          return visit(full);
+        },
+        &stats, nullptr);
+    result->tree_nodes += stats.nodes;
+    result->tree_checks += stats.checks;
+  }
 }
 
 void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
@@ -198,11 +258,17 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     if (v.plausible) CompleteEvidence(context, vo, &v);
   }
   std::stable_sort(verified.begin(), verified.end(), BetterThan);
-  const VerifiedPose& best = verified.front();
-  if (!best.plausible) {
-    result.reason = "no plausible pose (best: " + best.implausible_because + ")";
+  if (!verified.front().plausible) {
+    result.reason = "no plausible pose (best: " + verified.front().implausible_because + ")";
     return;
   }
+  // The best pose's rivals hidden by one of its correspondences join the comparison.
+  for (VerifiedPose& rival : LeaveOneOutRivals(context, vo, verified.front())) {
+    if (rival.plausible) CompleteEvidence(context, vo, &rival);
+    verified.push_back(std::move(rival));
+  }
+  std::stable_sort(verified.begin(), verified.end(), BetterThan);
+  const VerifiedPose& best = verified.front();
   // Finalists: the best pose, then the best of each distinct other pose (diagnostics).
   auto finalist = [&](const VerifiedPose& v) {
     Finalist f{v.pose, v.matched_edges, v.mean_distance_px, v.evidence, {}};

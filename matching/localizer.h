@@ -32,6 +32,10 @@ struct LocalizerOptions {
   InterpretationTreeOptions tree;
   BaselineOptions baseline;
   VerificationOptions verification;
+  // Budgets (nodes, checks, leaves, guided-matching pair tests) of each search over the lines an
+  // exhausted search's best pose leaves unexplained, as a share of the main search's (two such
+  // searches at most: the time of a localisation stays within 1 + 2 x this of the budget's).
+  double unexplained_search_share = 0.25;
 
   bool Check(std::string* why) const;
 };
@@ -98,6 +102,17 @@ class Localizer {
   const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
+  // An exhausted search may have missed the pose that explains the lines its best pose leaves
+  // unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the
+  // tree is searched again over those lines alone, with fresh budgets, its leaves handed to
+  // `visit` (which verifies them against all lines); when that finds nothing better, over the
+  // lines it does not explain with a reported correspondence.
+  void SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const std::vector<double>& caps,
+                              const std::vector<VerifiedPose>& verified, const LeafVisitor& visit,
+                              long* pair_tests, LocalizationResult* result) const;
+
   // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
   // and support checks) and fills `result`.
   void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,

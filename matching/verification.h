@@ -90,6 +90,8 @@ struct VerificationContext {
   LineNoise noise;  // line noise and calibration error (focal_relative)
   // When set, counts the (line, visible edge) pairs guided matching tests (the work budget).
   long* pair_tests = nullptr;
+  // When set, a pair (edge index, line index) guided matching may not use (a rival without it).
+  std::pair<int, int> excluded_pair = {-1, -1};
 };
 
 // Evidence for a pose (nats): the log-likelihood ratio of the observed lines under "the camera is
@@ -135,8 +137,9 @@ bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOpti
 // Makes a refined hypothesis consistent (the interpretation tree's gates are looser than the
 // chi-square test, so a leaf may hold wrong pairs beside true ones): when it is not, restarts
 // from the largest subset of its pairs agreeing with a minimal pose of two of them, then drops
-// the pair with the largest whitened residual and refines again while still inconsistent.
-// False when fewer than three pairs would be left.
+// the pair with the largest whitened residual and refines again while still inconsistent; then
+// drops the outlying pair (OutlyingPair) while there is one. False when fewer than three pairs
+// would be left.
 bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
                     VerifiedPose* hypothesis);
 
@@ -157,6 +160,27 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
 // then the plausibility checks and the lines term of the evidence.
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
                      const VerificationOptions& options);
+
+// The pair of a refined hypothesis that least fits the pose of the others: the largest
+// deleted-residual chi-square r' (I - H)^-1 r (r its whitened endpoint residuals, H = W J C J' W'
+// its leverage block; chi2(2) when the pair is true), when above gate_chi2; -1 when none is.
+int OutlyingPair(const VerificationContext& context, const VerificationOptions& options,
+                 const VerifiedPose& hypothesis);
+
+// The pose a refined hypothesis' pairs give without pair i, to first order: pose + C J_i'
+// (I - H_ii)^-1 r_i (whitened residuals r_i, Jacobian J_i, leverage H_ii = J_i C J_i'). False
+// (pose unchanged) when pair i alone fixes a direction of the pose (H_ii near the identity).
+bool DeletedPose(const VerificationContext& context, const VerifiedPose& verified, size_t i,
+                 Pose3Dof* pose);
+
+// The poses a verified pose's pairs give without one of its influential pairs (the first-order
+// deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
+// hypothesis_quantile of chi2(3)), each refined and verified by Rematch without that pair
+// (evidence lines term only). A pose that hinges on one correspondence has the pose of the
+// others as a rival explanation, which the tree does not verify (a subset of a verified leaf).
+std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
+                                            const VerificationOptions& options,
+                                            const VerifiedPose& verified);
 
 // RefineHypothesis, TrimHypothesis, then Rematch (a hypothesis that cannot be made consistent is
 // returned implausible without guided matching).

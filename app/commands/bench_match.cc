@@ -46,6 +46,7 @@ struct BenchMatchOptions {
   int clutter = 0;  // clutter lines per scene (0: the paper's 5 to 12)
   std::string out_path;
   std::string diagnose_path;  // JSON lines: every scene the tree does not answer correctly
+  std::vector<int> only;      // when not empty: run these scene indices only (debugging)
 };
 
 Series SeriesByName(const std::string& name) {
@@ -158,12 +159,19 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
   for (const auto& m : result.matches) {
     if (!truth.count(m)) wrong.push_back({m.first, m.second});
   }
+  nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
+  for (const Finalist& f : result.finalists) {
+    finalists.push_back(
+        {f.pose.x, f.pose.y, RadToDeg(f.pose.heading), f.evidence.Score(), f.matched_edges});
+  }
   return {{"scene", scene.index},
           {"outcome", OutcomeName(outcome)},
           {"category", category},
           {"reason", result.reason},
           {"hypotheses", result.hypotheses},
           {"budget_exhausted", result.budget_exhausted},
+          {"tree_nodes", result.tree_nodes},
+          {"tree_checks", result.tree_checks},
           {"pose_error",
            {std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y),
             RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)))}},
@@ -182,6 +190,8 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
           {"chosen_evidence",
            result.finalists.empty() ? 0.0 : result.finalists.front().evidence.Score()},
           {"observability", {d.position_sigma_m, d.heading_sigma_deg}},
+          {"truth_pose", {scene.truth.x, scene.truth.y, RadToDeg(scene.truth.heading)}},
+          {"finalists", finalists},
           {"pairs", pairs}};
 }
 
@@ -237,6 +247,10 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     std::map<std::string, int> categories;
     for (size_t i = 0; i < scenes.size(); ++i) {
       const SyntheticScene& scene = scenes[i];
+      if (!opt.only.empty() &&
+          std::find(opt.only.begin(), opt.only.end(), scene.index) == opt.only.end()) {
+        continue;
+      }
       const LocalizationProblem problem = ProblemOf(scene);
       for (int m = 0; m < (opt.baseline ? 2 : 1); ++m) {
         const auto start = std::chrono::steady_clock::now();
@@ -298,6 +312,9 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--diagnose", opt->diagnose_path,
                   "Write a JSON line per scene the tree does not answer correctly: where the "
                   "true correspondences are lost (matching/diagnosis.h)");
+  cmd->add_option("--only", opt->only,
+                  "Run only these scene indices (0-based, of the --count generated; debugging)")
+      ->delimiter(',');
   cmd->callback([opt, action] {
     if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
     if (opt->clutter < 0) throw CLI::ValidationError("--clutter", "must be at least 0");

@@ -1,0 +1,127 @@
+// Verification of hypotheses on synthetic scenes of the hall: the first-order pose without one
+// pair (DeletedPose) against a refit, the per-pair outlier test (OutlyingPair) on true pairs and
+// on a wrong pair hidden among them, and the leave-one-out rivals of a well-determined pose.
+#include "matching/verification.h"
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "models/synthetic_scenes.h"
+
+namespace linetrack {
+namespace {
+
+constexpr int kScenes = 12;
+// The first-order deleted pose agrees with a Levenberg-Marquardt refit without the pair within
+// this share of the shift, plus a floor for the refit's own convergence.
+constexpr double kDeletedShareOfShift = 0.25;
+constexpr double kDeletedFloorM = 0.01;
+constexpr double kDeletedFloorDeg = 0.05;
+
+class VerificationTest : public ::testing::Test {
+ protected:
+  VerificationTest()
+      : model_(WireframeModel::Load(std::string(LINETRACK_SOURCE_DIR) + "/models/hall.cao")),
+        area_(NavigableArea::FromModel(model_)) {
+    std::vector<int> ids(model_.edges().size());
+    std::iota(ids.begin(), ids.end(), 0);
+    edges_ = PrepareEdges(model_, ids);  // index = edge id
+    options_.refinement.focal_prior_sigma = noise_.focal_relative;
+  }
+
+  std::vector<SyntheticScene> Scenes(uint64_t seed, bool exact) const {
+    SyntheticSceneOptions options;
+    options.seed = seed;
+    options.count = kScenes;
+    if (exact) options.calibration_sigma = options.angle_sigma = options.offset_sigma_px = 0.0;
+    return GenerateScenes(model_, area_, options);
+  }
+
+  // The context of a scene (no prior, no occlusion: every pose is plausible where it is).
+  VerificationContext Context(const SyntheticScene& scene) {
+    camera_ = PaperSyntheticCamera().Undistorted();
+    lines_ = PrepareLines(scene.lines, camera_, scene.tilt, noise_, 3.5);
+    VerificationContext context;
+    context.edges = &edges_;
+    context.lines = &lines_;
+    context.camera = &camera_;
+    context.height = scene.height;
+    context.tilt = scene.tilt;
+    context.noise = noise_;
+    return context;
+  }
+
+  WireframeModel model_;
+  NavigableArea area_;
+  std::vector<MatchEdge> edges_;
+  std::vector<ObservedLine> lines_;
+  CameraIntrinsics camera_;
+  LineNoise noise_;
+  VerificationOptions options_;
+};
+
+TEST_F(VerificationTest, DeletedPoseMatchesARefitWithoutThePair) {
+  int compared = 0;
+  for (const SyntheticScene& scene : Scenes(21, false)) {
+    const VerificationContext context = Context(scene);
+    const VerifiedPose full =
+        RefineHypothesis(context, scene.matches, {scene.truth.Planar()}, options_);
+    for (size_t i = 0; i < full.pairs.size(); ++i) {
+      Pose3Dof deleted;
+      if (!DeletedPose(context, full, i, &deleted)) continue;
+      std::vector<std::pair<int, int>> others = full.pairs;
+      others.erase(others.begin() + static_cast<long>(i));
+      const Pose3Dof refit = RefineHypothesis(context, others, {full.pose}, options_).pose;
+      const double shift_m = std::hypot(refit.x - full.pose.x, refit.y - full.pose.y);
+      const double shift_deg = RadToDeg(std::abs(WrapAngle(refit.heading - full.pose.heading)));
+      EXPECT_LE(std::hypot(deleted.x - refit.x, deleted.y - refit.y),
+                kDeletedShareOfShift * shift_m + kDeletedFloorM)
+          << "scene " << scene.index << " pair " << i;
+      EXPECT_LE(RadToDeg(std::abs(WrapAngle(deleted.heading - refit.heading))),
+                kDeletedShareOfShift * shift_deg + kDeletedFloorDeg)
+          << "scene " << scene.index << " pair " << i;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 5 * kScenes);
+}
+
+TEST_F(VerificationTest, OutlyingPairFlagsOnlyAWrongPairHiddenAmongTrueOnes) {
+  int tested = 0;
+  for (const SyntheticScene& scene : Scenes(22, true)) {
+    const VerificationContext context = Context(scene);
+    const VerifiedPose truth =
+        RefineHypothesis(context, scene.matches, {scene.truth.Planar()}, options_);
+    EXPECT_EQ(OutlyingPair(context, options_, truth), -1) << "scene " << scene.index;
+    // The line of one true pair given to the edge of another (not on the same edge).
+    const auto [edge, line] = scene.matches.front();
+    const auto other = std::find_if(scene.matches.begin(), scene.matches.end(),
+                                    [&](const auto& m) { return m.first != edge; });
+    ASSERT_NE(other, scene.matches.end());
+    std::vector<std::pair<int, int>> pairs = scene.matches;
+    pairs.emplace_back(other->first, line);
+    const VerifiedPose wrong = RefineHypothesis(context, pairs, {scene.truth.Planar()}, options_);
+    EXPECT_EQ(OutlyingPair(context, options_, wrong), static_cast<int>(pairs.size()) - 1)
+        << "scene " << scene.index;
+    ++tested;
+  }
+  EXPECT_EQ(tested, kScenes);
+}
+
+TEST_F(VerificationTest, AWellDeterminedPoseHasNoLeaveOneOutRival) {
+  int tested = 0;
+  for (const SyntheticScene& scene : Scenes(23, true)) {
+    const VerificationContext context = Context(scene);
+    const VerifiedPose truth =
+        Rematch(context, RefineHypothesis(context, scene.matches, {scene.truth.Planar()}, options_),
+                options_);
+    if (truth.pairs.size() < 6) continue;  // a small hypothesis may hinge on one pair
+    EXPECT_TRUE(LeaveOneOutRivals(context, options_, truth).empty()) << "scene " << scene.index;
+    ++tested;
+  }
+  EXPECT_GE(tested, kScenes / 3);
+}
+
+}  // namespace
+}  // namespace linetrack
