@@ -34,9 +34,9 @@ HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
   return b;
 }
 
-bool Overlaps(const HeadingBin& bin, const std::vector<HeadingInterval>& parts) {
-  for (const HeadingInterval& p : parts) {
-    if (p.lo <= bin.hi && p.hi >= bin.lo) return true;
+bool Overlaps(const HeadingBin& bin, const HeadingInterval* parts, int count) {
+  for (int i = 0; i < count; ++i) {
+    if (parts[i].lo <= bin.hi && parts[i].hi >= bin.lo) return true;
   }
   return false;
 }
@@ -347,10 +347,10 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
                     const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
   if (in.Empty()) return false;
-  const std::vector<HeadingInterval> parts =
-      DirectionIntervals(line, edge.dir, in.Heading(), sigmas);
+  HeadingInterval parts[kMaxDirectionIntervals];
+  const int count = DirectionIntervals(line, edge.dir, in.Heading(), sigmas, parts);
   for (const HeadingBin& bin : in.bins) {
-    if (!Overlaps(bin, parts)) continue;
+    if (!Overlaps(bin, parts, count)) continue;
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
     // |s(q)| <= half_width: two half-planes of the unit line.
     HeadingBin& cut = Append(bin, out);
@@ -365,11 +365,11 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
 bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                       const FeasibleRegion& region) {
   if (region.Empty()) return false;
-  const std::vector<HeadingInterval> parts =
-      DirectionIntervals(line, edge.dir, region.Heading(), sigmas);
-  if (parts.empty()) return false;
+  HeadingInterval parts[kMaxDirectionIntervals];
+  const int count = DirectionIntervals(line, edge.dir, region.Heading(), sigmas, parts);
+  if (count == 0) return false;
   for (const HeadingBin& bin : region.bins) {
-    if (!Overlaps(bin, parts)) continue;
+    if (!Overlaps(bin, parts, count)) continue;
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
     if (bin.positions.Empty() ||
         bin.positions.MaxSideBound(band.normal, band.offset + band.half_width) < 0.0 ||
