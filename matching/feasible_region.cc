@@ -314,20 +314,6 @@ VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double
       a_(Trig(-line.bearing - margin_ + kPi)),
       b_(Trig(-line.bearing + margin_ + kPi)) {}
 
-bool VerticalCut::In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-                     double* d2) const {
-  if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
-  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-  };
-  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
-  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
-  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
-  *d1 = -n1->dot(foot_);
-  *d2 = -n2->dot(foot_);
-  return true;
-}
-
 bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
   if (in.Empty()) return false;
   const HeadingInterval heading = in.Heading();

@@ -134,7 +134,18 @@ class VerticalCut {
   // The wedge in `bin`: n1 . q + d1 >= 0 and n2 . q + d2 >= 0; false when the bin is too wide
   // for a wedge (everything allowed).
   bool In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-          double* d2) const;
+          double* d2) const {  // inline: called per bin of every forward check
+    if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
+    auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+      return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+    };
+    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
+    *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+    *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+    *d1 = -n1->dot(foot_);
+    *d2 = -n2->dot(foot_);
+    return true;
+  }
   // Quick test: the directions from the foot to the region's bounding box meet those the
   // headings allow (false: the cut empties the region).
   bool MayMeet(const FeasibleRegion& region) const;
