@@ -6,29 +6,34 @@
 namespace linetrack {
 namespace {
 
-// Intersects [j.lo, j.hi] shifted by multiples of 2 pi with `prior`; appends the overlaps.
-void IntersectModulo(const HeadingInterval& j, const HeadingInterval& prior,
-                     std::vector<HeadingInterval>* out) {
+// Intersects [j.lo, j.hi] shifted by multiples of 2 pi with `prior`; appends the overlaps to
+// out[*count] (room for 3 more).
+void IntersectModulo(const HeadingInterval& j, const HeadingInterval& prior, HeadingInterval* out,
+                     int* count) {
   const double shift = std::round((prior.Mid() - j.Mid()) / (2.0 * kPi));
   for (int k = -1; k <= 1; ++k) {
     const double s = 2.0 * kPi * (shift + k);
     const double lo = std::max(j.lo + s, prior.lo), hi = std::min(j.hi + s, prior.hi);
-    if (lo <= hi) out->push_back({lo, hi});
+    if (lo <= hi) out[(*count)++] = {lo, hi};
   }
 }
 
-// Merges overlapping intervals (sorted by lo).
-std::vector<HeadingInterval> Merge(std::vector<HeadingInterval> v) {
-  std::sort(v.begin(), v.end(), [](const auto& x, const auto& y) { return x.lo < y.lo; });
-  std::vector<HeadingInterval> out;
-  for (const HeadingInterval& i : v) {
-    if (!out.empty() && i.lo <= out.back().hi) {
-      out.back().hi = std::max(out.back().hi, i.hi);
+// Merges overlapping intervals in place (insertion sort by lo: equal lo merge alike in any
+// order); returns how many are left.
+int MergeInPlace(HeadingInterval* v, int count) {
+  for (int i = 1; i < count; ++i) {
+    for (int k = i; k > 0 && v[k].lo < v[k - 1].lo; --k)
+      std::swap(v[k], v[k - 1]);
+  }
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    if (kept > 0 && v[i].lo <= v[kept - 1].hi) {
+      v[kept - 1].hi = std::max(v[kept - 1].hi, v[i].hi);
     } else {
-      out.push_back(i);
+      v[kept++] = v[i];
     }
   }
-  return out;
+  return kept;
 }
 
 }  // namespace
@@ -74,24 +79,31 @@ std::vector<double> DirectionRoots(const Eigen::Vector3d& normal, const Eigen::V
 
 std::vector<HeadingInterval> DirectionIntervals(const ObservedLine& line, const Eigen::Vector3d& v,
                                                 const HeadingInterval& prior, double sigmas) {
+  HeadingInterval parts[kMaxDirectionIntervals];
+  const int count = DirectionIntervals(line, v, prior, sigmas, parts);
+  return std::vector<HeadingInterval>(parts, parts + count);
+}
+
+int DirectionIntervals(const ObservedLine& line, const Eigen::Vector3d& v,
+                       const HeadingInterval& prior, double sigmas, HeadingInterval* out) {
   const Eigen::Vector3d abc = DirectionCoefficients(line.normal, v);
   const double tolerance =
       sigmas * std::sqrt(FormVariance(line, LevelFromWorld(prior.Mid()) * v)) + 1e-12;
   const double rho = std::sqrt(abc.x() * abc.x() + abc.y() * abc.y());
-  std::vector<HeadingInterval> out;
   if (rho < 1e-12) {  // g1 does not depend on h (vertical edge): all or nothing
-    if (std::abs(abc.z()) <= tolerance) out.push_back(prior);
-    return out;
+    if (std::abs(abc.z()) > tolerance) return 0;
+    out[0] = prior;
+    return 1;
   }
   // rho cos(h - alpha) in [-c - tol, -c + tol].
   const double lo = (-abc.z() - tolerance) / rho, hi = (-abc.z() + tolerance) / rho;
-  if (hi < -1.0 || lo > 1.0) return out;
+  if (hi < -1.0 || lo > 1.0) return 0;
   const double alpha = std::atan2(abc.y(), abc.x());
   const double t_near = std::acos(std::min(hi, 1.0)), t_far = std::acos(std::max(lo, -1.0));
-  std::vector<HeadingInterval> parts;
-  IntersectModulo({alpha + t_near, alpha + t_far}, prior, &parts);
-  IntersectModulo({alpha - t_far, alpha - t_near}, prior, &parts);
-  return Merge(parts);
+  int count = 0;
+  IntersectModulo({alpha + t_near, alpha + t_far}, prior, out, &count);
+  IntersectModulo({alpha - t_far, alpha - t_near}, prior, out, &count);
+  return MergeInPlace(out, count);
 }
 
 Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p, double height,
@@ -292,10 +304,12 @@ std::optional<HeadingInterval> UnaryVertical(const ObservedLine& line, const Mat
   const double spread = std::asin(radius / distance) + sigmas * line.bearing_sigma;
   // Camera direction from the foot is (h - w) + pi; it must lie within gamma +- spread.
   const double h_mid = gamma - kPi + line.bearing;
-  std::vector<HeadingInterval> parts;
-  IntersectModulo({h_mid - spread, h_mid + spread}, prior, &parts);
-  if (parts.empty()) return std::nullopt;
-  return Merge(parts).front();
+  HeadingInterval parts[3];
+  int count = 0;
+  IntersectModulo({h_mid - spread, h_mid + spread}, prior, parts, &count);
+  if (count == 0) return std::nullopt;
+  MergeInPlace(parts, count);
+  return parts[0];
 }
 
 HeadingInterval InscribedAngleRange(const Eigen::Vector2d& foot1, const Eigen::Vector2d& foot2,

@@ -61,6 +61,11 @@ std::vector<double> DirectionRoots(const Eigen::Vector3d& normal, const Eigen::V
 // up to two intervals, clipped to `prior`; empty when the correspondence is impossible.
 std::vector<HeadingInterval> DirectionIntervals(const ObservedLine& line, const Eigen::Vector3d& v,
                                                 const HeadingInterval& prior, double sigmas);
+// The same written into `out` (room for kMaxDirectionIntervals), without allocating (the
+// tree's forward checking calls it per candidate and node); returns how many.
+constexpr int kMaxDirectionIntervals = 6;
+int DirectionIntervals(const ObservedLine& line, const Eigen::Vector3d& v,
+                       const HeadingInterval& prior, double sigmas, HeadingInterval* out);
 
 // The position line (A, B, C0) of the camera (x, y) at heading h: A x + B y + C0 = 0, with
 // A = -(nL_z cos h + nL_x sin h), B = nL_x cos h - nL_z sin h,

@@ -34,9 +34,9 @@ HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
   return b;
 }
 
-bool Overlaps(const HeadingBin& bin, const std::vector<HeadingInterval>& parts) {
-  for (const HeadingInterval& p : parts) {
-    if (p.lo <= bin.hi && p.hi >= bin.lo) return true;
+bool Overlaps(const HeadingBin& bin, const HeadingInterval* parts, int count) {
+  for (int i = 0; i < count; ++i) {
+    if (parts[i].lo <= bin.hi && parts[i].hi >= bin.lo) return true;
   }
   return false;
 }
@@ -54,25 +54,23 @@ ConvexPolygon ConvexPolygon::AroundDisk(const Eigen::Vector2d& centre, double ra
   return polygon;
 }
 
-void ConvexPolygon::Push(const Eigen::Vector2d& v) {
-  if (count_ == kMaxVertices) {
-    // Out of room (many cuts that each add a vertex): replace by the bounding box, which
-    // contains the polygon, so the region stays conservative.
-    Eigen::Vector2d lo = vertices_[0], hi = vertices_[0];
-    for (int i = 1; i < count_; ++i) {
-      lo = lo.cwiseMin(vertices_[i]);
-      hi = hi.cwiseMax(vertices_[i]);
-    }
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-    vertices_[0] = lo;
-    vertices_[1] = {hi.x(), lo.y()};
-    vertices_[2] = hi;
-    vertices_[3] = {lo.x(), hi.y()};
-    count_ = 4;
-    return;
+void ConvexPolygon::PushFull(const Eigen::Vector2d& v) {
+  // Out of room (many cuts that each add a vertex): replace by the bounding box, which
+  // contains the polygon, so the region stays conservative.
+  Eigen::Vector2d lo = vertices_[0], hi = vertices_[0];
+  for (int i = 1; i < count_; ++i) {
+    lo = lo.cwiseMin(vertices_[i]);
+    hi = hi.cwiseMax(vertices_[i]);
   }
-  vertices_[count_++] = v;
+  lo = lo.cwiseMin(v);
+  hi = hi.cwiseMax(v);
+  vertices_[0] = lo;
+  vertices_[1] = {hi.x(), lo.y()};
+  vertices_[2] = hi;
+  vertices_[3] = {lo.x(), hi.y()};
+  count_ = 4;
+  lo_ = lo;
+  hi_ = hi;
 }
 
 void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
@@ -86,43 +84,100 @@ void ConvexPolygon::ClipHalfPlane(const Eigen::Vector2d& n, double d) {
 }
 
 void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n, double d) {
-  count_ = 0;
+  std::array<double, kMaxVertices> side;
+  for (int i = 0; i < source.count_; ++i)
+    side[i] = n.dot(source.vertices_[i]) + d;
+  ClipFromSides(source, side.data());
+}
+
+void ConvexPolygon::ClipFromSides(const ConvexPolygon& source, const double* side) {
+  Clear();
   const int m = source.count_;
   for (int i = 0; i < m; ++i) {
+    const int k = i + 1 == m ? 0 : i + 1;
     const Eigen::Vector2d& a = source.vertices_[i];
-    const Eigen::Vector2d& b = source.vertices_[(i + 1) % m];
-    const double fa = n.dot(a) + d, fb = n.dot(b) + d;
+    const double fa = side[i], fb = side[k];
     if (fa >= 0.0) Push(a);
-    if ((fa >= 0.0) != (fb >= 0.0)) Push(a + (fa / (fa - fb)) * (b - a));
+    if ((fa >= 0.0) != (fb >= 0.0)) Push(a + (fa / (fa - fb)) * (source.vertices_[k] - a));
   }
 }
 
 void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
                              const Eigen::Vector2d& n2, double d2) {
-  // Most cuts keep a polygon whole or drop it: decide those from the vertices' sides first.
+  // Most cuts keep a polygon whole or drop it: decide those from the box, then from the
+  // vertices' sides.
+  if (source.count_ == 0 || source.MaxSideBound(n1, d1) < 0.0 ||
+      source.MaxSideBound(n2, d2) < 0.0) {
+    Clear();
+    return;
+  }
+  std::array<double, kMaxVertices> side1, side2;
   bool all1 = true, all2 = true, any1 = false, any2 = false;
   for (int i = 0; i < source.count_; ++i) {
-    const bool in1 = n1.dot(source.vertices_[i]) + d1 >= 0.0;
-    const bool in2 = n2.dot(source.vertices_[i]) + d2 >= 0.0;
+    side1[i] = n1.dot(source.vertices_[i]) + d1;
+    side2[i] = n2.dot(source.vertices_[i]) + d2;
+    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
     all1 = all1 && in1;
     all2 = all2 && in2;
     any1 = any1 || in1;
     any2 = any2 || in2;
   }
   if (!any1 || !any2) {
-    count_ = 0;
+    Clear();
   } else if (all1 && all2) {
     std::copy(source.begin(), source.end(), vertices_.begin());
     count_ = source.count_;
+    lo_ = source.lo_;
+    hi_ = source.hi_;
   } else if (all1) {
-    ClipFrom(source, n2, d2);
+    ClipFromSides(source, side2.data());
   } else if (all2) {
-    ClipFrom(source, n1, d1);
+    ClipFromSides(source, side1.data());
   } else {
     ConvexPolygon half;
-    half.ClipFrom(source, n1, d1);
+    half.ClipFromSides(source, side1.data());
     ClipFrom(half, n2, d2);
   }
+}
+
+namespace {
+
+// Vertices ClipFromSides would push: those inside and the crossings. The clip is Empty() exactly
+// when they are fewer than 3 (a full polygon is replaced by a 4-vertex box, never fewer).
+int ClippedCount(int m, const double* side) {
+  int count = 0;
+  for (int i = 0; i < m; ++i) {
+    const double fa = side[i], fb = side[i + 1 == m ? 0 : i + 1];
+    count += (fa >= 0.0 ? 1 : 0) + ((fa >= 0.0) != (fb >= 0.0) ? 1 : 0);
+  }
+  return count;
+}
+
+}  // namespace
+
+bool ConvexPolygon::MeetsBoth(const Eigen::Vector2d& n1, double d1, const Eigen::Vector2d& n2,
+                              double d2) const {
+  if (count_ == 0 || MaxSideBound(n1, d1) < 0.0 || MaxSideBound(n2, d2) < 0.0) return false;
+  std::array<double, kMaxVertices> side1, side2;
+  bool all1 = true, all2 = true, any1 = false, any2 = false;
+  for (int i = 0; i < count_; ++i) {
+    side1[i] = n1.dot(vertices_[i]) + d1;
+    side2[i] = n2.dot(vertices_[i]) + d2;
+    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
+    all1 = all1 && in1;
+    all2 = all2 && in2;
+    any1 = any1 || in1;
+    any2 = any2 || in2;
+  }
+  if (!any1 || !any2) return false;
+  if (all1 && all2) return !Empty();
+  if (all1) return ClippedCount(count_, side2.data()) >= 3;
+  if (all2) return ClippedCount(count_, side1.data()) >= 3;
+  ConvexPolygon half;
+  half.ClipFromSides(*this, side1.data());
+  for (int i = 0; i < half.count_; ++i)
+    side2[i] = n2.dot(half.vertices_[i]) + d2;
+  return ClippedCount(half.count_, side2.data()) >= 3;
 }
 
 Eigen::Vector2d ConvexPolygon::Centroid() const {
@@ -259,20 +314,6 @@ VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double
       a_(Trig(-line.bearing - margin_ + kPi)),
       b_(Trig(-line.bearing + margin_ + kPi)) {}
 
-bool VerticalCut::In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-                     double* d2) const {
-  if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
-  auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
-  };
-  const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
-  *n1 = Eigen::Vector2d(-u1.y(), u1.x());
-  *n2 = Eigen::Vector2d(u2.y(), -u2.x());
-  *d1 = -n1->dot(foot_);
-  *d2 = -n2->dot(foot_);
-  return true;
-}
-
 bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
   if (in.Empty()) return false;
   const HeadingInterval heading = in.Heading();
@@ -292,10 +333,10 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
                     const FeasibleRegion& in, FeasibleRegion* out) {
   out->bins.clear();
   if (in.Empty()) return false;
-  const std::vector<HeadingInterval> parts =
-      DirectionIntervals(line, edge.dir, in.Heading(), sigmas);
+  HeadingInterval parts[kMaxDirectionIntervals];
+  const int count = DirectionIntervals(line, edge.dir, in.Heading(), sigmas, parts);
   for (const HeadingBin& bin : in.bins) {
-    if (!Overlaps(bin, parts)) continue;
+    if (!Overlaps(bin, parts, count)) continue;
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
     // |s(q)| <= half_width: two half-planes of the unit line.
     HeadingBin& cut = Append(bin, out);
@@ -310,12 +351,17 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
 bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                       const FeasibleRegion& region) {
   if (region.Empty()) return false;
-  const std::vector<HeadingInterval> parts =
-      DirectionIntervals(line, edge.dir, region.Heading(), sigmas);
-  if (parts.empty()) return false;
+  HeadingInterval parts[kMaxDirectionIntervals];
+  const int count = DirectionIntervals(line, edge.dir, region.Heading(), sigmas, parts);
+  if (count == 0) return false;
   for (const HeadingBin& bin : region.bins) {
-    if (!Overlaps(bin, parts)) continue;
+    if (!Overlaps(bin, parts, count)) continue;
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
+    if (bin.positions.Empty() ||
+        bin.positions.MaxSideBound(band.normal, band.offset + band.half_width) < 0.0 ||
+        bin.positions.MaxSideBound(-band.normal, band.half_width - band.offset) < 0.0) {
+      continue;
+    }
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const Eigen::Vector2d& q : bin.positions) {
       const double s = band.normal.dot(q) + band.offset;
@@ -352,24 +398,11 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
 
 bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region) {
   if (region.bins.size() > 4 && !cut.MayMeet(region)) return false;
-  ConvexPolygon scratch;
   for (const HeadingBin& bin : region.bins) {
     Eigen::Vector2d n1, n2;
     double d1 = 0.0, d2 = 0.0;
     if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
-    // Quick answers before clipping: every vertex outside one half-plane (no), or inside both
-    // (yes).
-    bool all_in = true, any_in1 = false, any_in2 = false;
-    for (const Eigen::Vector2d& q : bin.positions) {
-      const bool in1 = n1.dot(q) + d1 >= 0.0, in2 = n2.dot(q) + d2 >= 0.0;
-      any_in1 = any_in1 || in1;
-      any_in2 = any_in2 || in2;
-      all_in = all_in && in1 && in2;
-    }
-    if (all_in && !bin.positions.Empty()) return true;
-    if (!any_in1 || !any_in2) continue;
-    scratch.ClipFrom(bin.positions, n1, d1, n2, d2);
-    if (!scratch.Empty()) return true;
+    if (bin.positions.MeetsBoth(n1, d1, n2, d2)) return true;
   }
   return false;
 }

@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "matching/constraints.h"
@@ -33,16 +35,45 @@ class ConvexPolygon {
   // The same with two half-planes (a band or a wedge).
   void ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d& n1, double d1,
                 const Eigen::Vector2d& n2, double d2);
+  // True when the part of this polygon where n1 . p + d1 >= 0 and n2 . p + d2 >= 0 is not
+  // Empty(): the same answer as ClipFrom with two half-planes, without building it all.
+  bool MeetsBoth(const Eigen::Vector2d& n1, double d1, const Eigen::Vector2d& n2, double d2) const;
   bool Empty() const { return count_ < 3; }
   Eigen::Vector2d Centroid() const;  // mean of the vertices
   int size() const { return count_; }
   const Eigen::Vector2d* begin() const { return vertices_.data(); }
   const Eigen::Vector2d* end() const { return vertices_.data() + count_; }
+  // Largest n . p + d over the bounding box, plus a rounding margin: when negative, n . v + d is
+  // negative for every vertex v as computed (a cheap rejection that cannot change a decision).
+  double MaxSideBound(const Eigen::Vector2d& n, double d) const {
+    const double x = n.x() > 0.0 ? hi_.x() : lo_.x(), y = n.y() > 0.0 ? hi_.y() : lo_.y();
+    const double scale = std::abs(n.x() * x) + std::abs(n.y() * y) + std::abs(d);
+    return n.x() * x + n.y() * y + d + 1e-9 * (1.0 + scale);
+  }
 
  private:
-  void Push(const Eigen::Vector2d& v);
+  void Push(const Eigen::Vector2d& v) {
+    if (count_ == kMaxVertices) {
+      PushFull(v);
+      return;
+    }
+    lo_ = lo_.cwiseMin(v);
+    hi_ = hi_.cwiseMax(v);
+    vertices_[count_++] = v;
+  }
+  void Clear() {
+    count_ = 0;
+    lo_.setConstant(std::numeric_limits<double>::infinity());
+    hi_ = -lo_;
+  }
+  void PushFull(const Eigen::Vector2d& v);
+  // ClipFrom with side[i] = n . source[i] + d given.
+  void ClipFromSides(const ConvexPolygon& source, const double* side);
   std::array<Eigen::Vector2d, kMaxVertices> vertices_;
   int count_ = 0;
+  // Bounding box of the vertices, kept by Push and Clear.
+  Eigen::Vector2d lo_ = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi_ = Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity());
 };
 
 // Positions possible for headings in [lo, hi]; (cos, sin) of lo, mid and hi cached.
@@ -103,7 +134,18 @@ class VerticalCut {
   // The wedge in `bin`: n1 . q + d1 >= 0 and n2 . q + d2 >= 0; false when the bin is too wide
   // for a wedge (everything allowed).
   bool In(const HeadingBin& bin, Eigen::Vector2d* n1, double* d1, Eigen::Vector2d* n2,
-          double* d2) const;
+          double* d2) const {  // inline: called per bin of every forward check
+    if (bin.hi - bin.lo + 2.0 * margin_ >= kPi) return false;
+    auto rotate = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+      return Eigen::Vector2d(x.x() * y.x() - x.y() * y.y(), x.x() * y.y() + x.y() * y.x());
+    };
+    const Eigen::Vector2d u1 = rotate(bin.trig_lo, a_), u2 = rotate(bin.trig_hi, b_);
+    *n1 = Eigen::Vector2d(-u1.y(), u1.x());
+    *n2 = Eigen::Vector2d(u2.y(), -u2.x());
+    *d1 = -n1->dot(foot_);
+    *d2 = -n2->dot(foot_);
+    return true;
+  }
   // Quick test: the directions from the foot to the region's bounding box meet those the
   // headings allow (false: the cut empties the region).
   bool MayMeet(const FeasibleRegion& region) const;
