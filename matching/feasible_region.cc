@@ -314,19 +314,21 @@ VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double
       a_(Trig(-line.bearing - margin_ + kPi)),
       b_(Trig(-line.bearing + margin_ + kPi)) {}
 
-bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
-  if (in.Empty()) return false;
-  const HeadingInterval heading = in.Heading();
-  if (heading.Width() + 2.0 * margin_ >= kPi) return true;
-  const Eigen::Vector2d centre = 0.5 * (in.box_lo + in.box_hi);
-  const double reach = 0.5 * (in.box_hi - in.box_lo).norm();
-  const Eigen::Vector2d to_box = centre - foot_;
+BoxView ViewBox(const FeasibleRegion& region, const Eigen::Vector2d& from) {
+  BoxView view;
+  const Eigen::Vector2d centre = 0.5 * (region.box_lo + region.box_hi);
+  const double reach = 0.5 * (region.box_hi - region.box_lo).norm();
+  const Eigen::Vector2d to_box = centre - from;
   const double distance = to_box.norm();
-  if (distance <= reach) return true;
-  const double spread = std::asin(reach / distance);
-  const double wanted = heading.Mid() - bearing_ + kPi;
-  const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
-  return offset <= spread + 0.5 * heading.Width() + margin_;
+  view.covers = distance <= reach;
+  if (view.covers) return view;
+  view.spread = std::asin(reach / distance);
+  view.direction = std::atan2(to_box.y(), to_box.x());
+  return view;
+}
+
+bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
+  return MayMeet(in, [&] { return ViewBox(in, foot_); });
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
@@ -397,14 +399,7 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
 }
 
 bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region) {
-  if (region.bins.size() > 4 && !cut.MayMeet(region)) return false;
-  for (const HeadingBin& bin : region.bins) {
-    Eigen::Vector2d n1, n2;
-    double d1 = 0.0, d2 = 0.0;
-    if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
-    if (bin.positions.MeetsBoth(n1, d1, n2, d2)) return true;
-  }
-  return false;
+  return MeetsVertical(cut, region, [&] { return ViewBox(region, cut.foot()); });
 }
 
 bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
