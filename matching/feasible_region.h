@@ -78,6 +78,17 @@ class ConvexPolygon {
 
 // Positions possible for headings in [lo, hi]; (cos, sin) of lo, mid and hi cached.
 struct HeadingBin {
+  // User-provided, so appending a bin to a vector does not zero the polygon's unused vertices
+  // (value-initialisation of an aggregate would: about 600 bytes per bin of every cut).
+  HeadingBin() {}
+  HeadingBin(double lo, double hi, const Eigen::Vector2d& trig_lo, const Eigen::Vector2d& trig_mid,
+             const Eigen::Vector2d& trig_hi, const ConvexPolygon& positions)
+      : lo(lo),
+        hi(hi),
+        trig_lo(trig_lo),
+        trig_mid(trig_mid),
+        trig_hi(trig_hi),
+        positions(positions) {}
   double lo = 0.0, hi = 0.0;
   Eigen::Vector2d trig_lo, trig_mid, trig_hi;
   ConvexPolygon positions;
