@@ -7,10 +7,8 @@
 namespace linetrack {
 namespace {
 
-// Position line at the heading whose (cos, sin) is `trig`, normalised so |(A, B)| = 1.
-Eigen::Vector3d UnitPositionLine(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                                 const Eigen::Vector2d& trig) {
-  const Eigen::Vector3d l = PositionLine(line.normal, p, height, trig.x(), trig.y());
+// A position line normalised so |(A, B)| = 1.
+Eigen::Vector3d Unit(const Eigen::Vector3d& l) {
   return l / std::sqrt(l.x() * l.x() + l.y() * l.y());
 }
 
@@ -290,19 +288,21 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
   const Eigen::Vector2d centre = bin.positions.Centroid();
   const Eigen::Vector3d p =
       ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
-  const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
-  const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
-  const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
+  const PositionLines lines(line.normal, p, height);
+  const Eigen::Vector3d mid_line = lines.At(bin.trig_mid.x(), bin.trig_mid.y());
+  const Eigen::Vector3d mid = Unit(mid_line);
+  const Eigen::Vector3d lo = Unit(lines.At(bin.trig_lo.x(), bin.trig_lo.y()));
+  const Eigen::Vector3d hi = Unit(lines.At(bin.trig_hi.x(), bin.trig_hi.y()));
   double slack = 0.0;
   for (const Eigen::Vector2d& q : bin.positions) {
     const double s = SignedDistance(mid, q);
     slack =
         std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
   }
-  return {
-      Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
-      PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas) +
-          slack};
+  return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
+          PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas,
+                                mid_line) +
+              slack};
 }
 
 }  // namespace
