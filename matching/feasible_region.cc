@@ -281,6 +281,7 @@ struct Band {
   Eigen::Vector2d normal;
   double offset = 0.0;  // s(q) = normal . q + offset
   double half_width = 0.0;
+  double lo = 0.0, hi = 0.0;  // least and greatest s over the polygon's vertices
 };
 
 Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
@@ -293,16 +294,19 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
   const Eigen::Vector3d mid = Unit(mid_line);
   const Eigen::Vector3d lo = Unit(lines.At(bin.trig_lo.x(), bin.trig_lo.y()));
   const Eigen::Vector3d hi = Unit(lines.At(bin.trig_hi.x(), bin.trig_hi.y()));
-  double slack = 0.0;
+  double slack = 0.0, lo_s = std::numeric_limits<double>::infinity(), hi_s = -lo_s;
   for (const Eigen::Vector2d& q : bin.positions) {
     const double s = SignedDistance(mid, q);
+    lo_s = std::min(lo_s, s);
+    hi_s = std::max(hi_s, s);
     slack =
         std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
   }
   return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
           PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas,
                                 mid_line) +
-              slack};
+              slack,
+          lo_s, hi_s};
 }
 
 }  // namespace
@@ -358,19 +362,11 @@ bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double he
   if (count == 0) return false;
   for (const HeadingBin& bin : region.bins) {
     if (!Overlaps(bin, parts, count)) continue;
+    if (bin.positions.Empty()) continue;
+    // The band's own pass over the vertices gave the range of s (the bounding-box rejection
+    // that stood here cannot change this test's answer).
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
-    if (bin.positions.Empty() ||
-        bin.positions.MaxSideBound(band.normal, band.offset + band.half_width) < 0.0 ||
-        bin.positions.MaxSideBound(-band.normal, band.half_width - band.offset) < 0.0) {
-      continue;
-    }
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Eigen::Vector2d& q : bin.positions) {
-      const double s = band.normal.dot(q) + band.offset;
-      lo = std::min(lo, s);
-      hi = std::max(hi, s);
-    }
-    if (hi >= -band.half_width && lo <= band.half_width) return true;
+    if (band.hi >= -band.half_width && band.lo <= band.half_width) return true;
   }
   return false;
 }
