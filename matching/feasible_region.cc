@@ -32,6 +32,19 @@ HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
   return b;
 }
 
+// side_k[i] = n_k . v[i] + d_k for the m vertices and both half-planes; inside_k counts the
+// vertices on the kept side (side_k >= 0).
+void BothSides(const Eigen::Vector2d* v, int m, const Eigen::Vector2d& n1, double d1,
+               const Eigen::Vector2d& n2, double d2, double* side1, double* side2, int* inside1,
+               int* inside2) {
+  for (int i = 0; i < m; ++i) {
+    side1[i] = n1.dot(v[i]) + d1;
+    side2[i] = n2.dot(v[i]) + d2;
+    *inside1 += side1[i] >= 0.0 ? 1 : 0;
+    *inside2 += side2[i] >= 0.0 ? 1 : 0;
+  }
+}
+
 bool Overlaps(const HeadingBin& bin, const HeadingInterval* parts, int count) {
   for (int i = 0; i < count; ++i) {
     if (parts[i].lo <= bin.hi && parts[i].hi >= bin.lo) return true;
@@ -110,17 +123,11 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
     return;
   }
   std::array<double, kMaxVertices> side1, side2;
-  bool all1 = true, all2 = true, any1 = false, any2 = false;
-  for (int i = 0; i < source.count_; ++i) {
-    side1[i] = n1.dot(source.vertices_[i]) + d1;
-    side2[i] = n2.dot(source.vertices_[i]) + d2;
-    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
-    all1 = all1 && in1;
-    all2 = all2 && in2;
-    any1 = any1 || in1;
-    any2 = any2 || in2;
-  }
-  if (!any1 || !any2) {
+  int inside1 = 0, inside2 = 0;
+  BothSides(source.begin(), source.count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1,
+            &inside2);
+  const bool all1 = inside1 == source.count_, all2 = inside2 == source.count_;
+  if (inside1 == 0 || inside2 == 0) {
     Clear();
   } else if (all1 && all2) {
     std::copy(source.begin(), source.end(), vertices_.begin());
@@ -157,17 +164,10 @@ bool ConvexPolygon::MeetsBoth(const Eigen::Vector2d& n1, double d1, const Eigen:
                               double d2) const {
   if (count_ == 0 || MaxSideBound(n1, d1) < 0.0 || MaxSideBound(n2, d2) < 0.0) return false;
   std::array<double, kMaxVertices> side1, side2;
-  bool all1 = true, all2 = true, any1 = false, any2 = false;
-  for (int i = 0; i < count_; ++i) {
-    side1[i] = n1.dot(vertices_[i]) + d1;
-    side2[i] = n2.dot(vertices_[i]) + d2;
-    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
-    all1 = all1 && in1;
-    all2 = all2 && in2;
-    any1 = any1 || in1;
-    any2 = any2 || in2;
-  }
-  if (!any1 || !any2) return false;
+  int inside1 = 0, inside2 = 0;
+  BothSides(begin(), count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1, &inside2);
+  const bool all1 = inside1 == count_, all2 = inside2 == count_;
+  if (inside1 == 0 || inside2 == 0) return false;
   if (all1 && all2) return !Empty();
   if (all1) return ClippedCount(count_, side2.data()) >= 3;
   if (all2) return ClippedCount(count_, side1.data()) >= 3;
