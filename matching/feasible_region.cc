@@ -203,11 +203,9 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
 void FeasibleRegion::UpdateBox() {
   box_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   box_hi = -box_lo;
-  for (const HeadingBin& bin : bins) {
-    for (const Eigen::Vector2d& q : bin.positions) {
-      box_lo = box_lo.cwiseMin(q);
-      box_hi = box_hi.cwiseMax(q);
-    }
+  for (const HeadingBin& bin : bins) {  // the polygons keep their boxes
+    box_lo = box_lo.cwiseMin(bin.positions.box_lo());
+    box_hi = box_hi.cwiseMax(bin.positions.box_hi());
   }
 }
 

@@ -43,6 +43,9 @@ class ConvexPolygon {
   int size() const { return count_; }
   const Eigen::Vector2d* begin() const { return vertices_.data(); }
   const Eigen::Vector2d* end() const { return vertices_.data() + count_; }
+  // Bounding box of the vertices (exactly their least and greatest coordinates; empty: +inf, -inf).
+  const Eigen::Vector2d& box_lo() const { return lo_; }
+  const Eigen::Vector2d& box_hi() const { return hi_; }
   // Largest n . p + d over the bounding box, plus a rounding margin: when negative, n . v + d is
   // negative for every vertex v as computed (a cheap rejection that cannot change a decision).
   double MaxSideBound(const Eigen::Vector2d& n, double d) const {
