@@ -113,9 +113,7 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p,
 
 Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p, double height,
                              double ch, double sh) {
-  return {-(n.z() * ch + n.x() * sh), n.x() * ch - n.z() * sh,
-          ch * (n.z() * p.x() - n.x() * p.y()) + sh * (n.x() * p.x() + n.z() * p.y()) -
-              n.y() * (p.z() - height)};
+  return PositionLines(n, p, height).At(ch, sh);
 }
 
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
@@ -125,10 +123,16 @@ double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
 
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double ch, double sh, const Eigen::Vector2d& at, double sigmas) {
+  return PositionBandHalfWidth(line, p, height, ch, sh, at, sigmas,
+                               PositionLine(line.normal, p, height, ch, sh));
+}
+
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double ch, double sh, const Eigen::Vector2d& at, double sigmas,
+                             const Eigen::Vector3d& l) {
   // Rl(h) (p - C), Rl(h) with rows (sin h, -cos h, 0), (0, 0, -1), (cos h, sin h, 0).
   const Eigen::Vector3d d = p - Eigen::Vector3d(at.x(), at.y(), height);
   const Eigen::Vector3d w(sh * d.x() - ch * d.y(), -d.z(), ch * d.x() + sh * d.y());
-  const Eigen::Vector3d l = PositionLine(line.normal, p, height, ch, sh);
   const double ab = std::sqrt(l.x() * l.x() + l.y() * l.y());
   if (ab < 1e-12) return std::numeric_limits<double>::infinity();
   return sigmas * std::sqrt(FormVariance(line, w)) / ab;

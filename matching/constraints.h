@@ -75,6 +75,24 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& normal, const Eigen::Vector3
 // The same with cos h, sin h given (hot loops).
 Eigen::Vector3d PositionLine(const Eigen::Vector3d& normal, const Eigen::Vector3d& p, double height,
                              double cos_h, double sin_h);
+// PositionLine of one (normal, p, height) at several headings: the terms that do not depend on
+// the heading computed once (the same values as PositionLine, bit for bit).
+class PositionLines {
+ public:
+  PositionLines(const Eigen::Vector3d& normal, const Eigen::Vector3d& p, double height)
+      : n_(normal),
+        c_(normal.z() * p.x() - normal.x() * p.y()),
+        s_(normal.x() * p.x() + normal.z() * p.y()),
+        z_(normal.y() * (p.z() - height)) {}
+  Eigen::Vector3d At(double cos_h, double sin_h) const {
+    return {-(n_.z() * cos_h + n_.x() * sin_h), n_.x() * cos_h - n_.z() * sin_h,
+            cos_h * c_ + sin_h * s_ - z_};
+  }
+
+ private:
+  Eigen::Vector3d n_;
+  double c_, s_, z_;
+};
 
 // Half-width (metres) of the noise band around the position line at camera position `at`:
 // sigmas * std(g2) / |(A, B)|.
@@ -83,6 +101,10 @@ double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
 // The same with cos h, sin h given (hot loops).
 double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
                              double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas);
+// The same with PositionLine(line.normal, p, height, cos_h, sin_h) given as `position_line`.
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
+                             double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas,
+                             const Eigen::Vector3d& position_line);
 
 // The point of the edge (clamped to it) seen along the segment's middle ray from camera
 // position `at` at heading h: the closest point of the edge's line to that viewing ray. The

@@ -7,10 +7,8 @@
 namespace linetrack {
 namespace {
 
-// Position line at the heading whose (cos, sin) is `trig`, normalised so |(A, B)| = 1.
-Eigen::Vector3d UnitPositionLine(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                                 const Eigen::Vector2d& trig) {
-  const Eigen::Vector3d l = PositionLine(line.normal, p, height, trig.x(), trig.y());
+// A position line normalised so |(A, B)| = 1.
+Eigen::Vector3d Unit(const Eigen::Vector3d& l) {
   return l / std::sqrt(l.x() * l.x() + l.y() * l.y());
 }
 
@@ -32,6 +30,19 @@ HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
   b.trig_mid = bin.trig_mid;
   b.trig_hi = bin.trig_hi;
   return b;
+}
+
+// side_k[i] = n_k . v[i] + d_k for the m vertices and both half-planes; inside_k counts the
+// vertices on the kept side (side_k >= 0).
+void BothSides(const Eigen::Vector2d* v, int m, const Eigen::Vector2d& n1, double d1,
+               const Eigen::Vector2d& n2, double d2, double* side1, double* side2, int* inside1,
+               int* inside2) {
+  for (int i = 0; i < m; ++i) {
+    side1[i] = n1.dot(v[i]) + d1;
+    side2[i] = n2.dot(v[i]) + d2;
+    *inside1 += side1[i] >= 0.0 ? 1 : 0;
+    *inside2 += side2[i] >= 0.0 ? 1 : 0;
+  }
 }
 
 bool Overlaps(const HeadingBin& bin, const HeadingInterval* parts, int count) {
@@ -112,17 +123,11 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
     return;
   }
   std::array<double, kMaxVertices> side1, side2;
-  bool all1 = true, all2 = true, any1 = false, any2 = false;
-  for (int i = 0; i < source.count_; ++i) {
-    side1[i] = n1.dot(source.vertices_[i]) + d1;
-    side2[i] = n2.dot(source.vertices_[i]) + d2;
-    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
-    all1 = all1 && in1;
-    all2 = all2 && in2;
-    any1 = any1 || in1;
-    any2 = any2 || in2;
-  }
-  if (!any1 || !any2) {
+  int inside1 = 0, inside2 = 0;
+  BothSides(source.begin(), source.count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1,
+            &inside2);
+  const bool all1 = inside1 == source.count_, all2 = inside2 == source.count_;
+  if (inside1 == 0 || inside2 == 0) {
     Clear();
   } else if (all1 && all2) {
     std::copy(source.begin(), source.end(), vertices_.begin());
@@ -159,17 +164,10 @@ bool ConvexPolygon::MeetsBoth(const Eigen::Vector2d& n1, double d1, const Eigen:
                               double d2) const {
   if (count_ == 0 || MaxSideBound(n1, d1) < 0.0 || MaxSideBound(n2, d2) < 0.0) return false;
   std::array<double, kMaxVertices> side1, side2;
-  bool all1 = true, all2 = true, any1 = false, any2 = false;
-  for (int i = 0; i < count_; ++i) {
-    side1[i] = n1.dot(vertices_[i]) + d1;
-    side2[i] = n2.dot(vertices_[i]) + d2;
-    const bool in1 = side1[i] >= 0.0, in2 = side2[i] >= 0.0;
-    all1 = all1 && in1;
-    all2 = all2 && in2;
-    any1 = any1 || in1;
-    any2 = any2 || in2;
-  }
-  if (!any1 || !any2) return false;
+  int inside1 = 0, inside2 = 0;
+  BothSides(begin(), count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1, &inside2);
+  const bool all1 = inside1 == count_, all2 = inside2 == count_;
+  if (inside1 == 0 || inside2 == 0) return false;
   if (all1 && all2) return !Empty();
   if (all1) return ClippedCount(count_, side2.data()) >= 3;
   if (all2) return ClippedCount(count_, side1.data()) >= 3;
@@ -205,11 +203,9 @@ FeasibleRegion FeasibleRegion::FromPrior(const HeadingInterval& heading,
 void FeasibleRegion::UpdateBox() {
   box_lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   box_hi = -box_lo;
-  for (const HeadingBin& bin : bins) {
-    for (const Eigen::Vector2d& q : bin.positions) {
-      box_lo = box_lo.cwiseMin(q);
-      box_hi = box_hi.cwiseMax(q);
-    }
+  for (const HeadingBin& bin : bins) {  // the polygons keep their boxes
+    box_lo = box_lo.cwiseMin(bin.positions.box_lo());
+    box_hi = box_hi.cwiseMax(bin.positions.box_hi());
   }
 }
 
@@ -283,6 +279,7 @@ struct Band {
   Eigen::Vector2d normal;
   double offset = 0.0;  // s(q) = normal . q + offset
   double half_width = 0.0;
+  double lo = 0.0, hi = 0.0;  // least and greatest s over the polygon's vertices
 };
 
 Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
@@ -290,19 +287,24 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
   const Eigen::Vector2d centre = bin.positions.Centroid();
   const Eigen::Vector3d p =
       ObservedPointOnEdge(line, edge, height, bin.trig_mid.x(), bin.trig_mid.y(), centre);
-  const Eigen::Vector3d mid = UnitPositionLine(line, p, height, bin.trig_mid);
-  const Eigen::Vector3d lo = UnitPositionLine(line, p, height, bin.trig_lo);
-  const Eigen::Vector3d hi = UnitPositionLine(line, p, height, bin.trig_hi);
-  double slack = 0.0;
+  const PositionLines lines(line.normal, p, height);
+  const Eigen::Vector3d mid_line = lines.At(bin.trig_mid.x(), bin.trig_mid.y());
+  const Eigen::Vector3d mid = Unit(mid_line);
+  const Eigen::Vector3d lo = Unit(lines.At(bin.trig_lo.x(), bin.trig_lo.y()));
+  const Eigen::Vector3d hi = Unit(lines.At(bin.trig_hi.x(), bin.trig_hi.y()));
+  double slack = 0.0, lo_s = std::numeric_limits<double>::infinity(), hi_s = -lo_s;
   for (const Eigen::Vector2d& q : bin.positions) {
     const double s = SignedDistance(mid, q);
+    lo_s = std::min(lo_s, s);
+    hi_s = std::max(hi_s, s);
     slack =
         std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
   }
-  return {
-      Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
-      PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas) +
-          slack};
+  return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
+          PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas,
+                                mid_line) +
+              slack,
+          lo_s, hi_s};
 }
 
 }  // namespace
@@ -314,19 +316,21 @@ VerticalCut::VerticalCut(const ObservedLine& line, const MatchEdge& edge, double
       a_(Trig(-line.bearing - margin_ + kPi)),
       b_(Trig(-line.bearing + margin_ + kPi)) {}
 
-bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
-  if (in.Empty()) return false;
-  const HeadingInterval heading = in.Heading();
-  if (heading.Width() + 2.0 * margin_ >= kPi) return true;
-  const Eigen::Vector2d centre = 0.5 * (in.box_lo + in.box_hi);
-  const double reach = 0.5 * (in.box_hi - in.box_lo).norm();
-  const Eigen::Vector2d to_box = centre - foot_;
+BoxView ViewBox(const FeasibleRegion& region, const Eigen::Vector2d& from) {
+  BoxView view;
+  const Eigen::Vector2d centre = 0.5 * (region.box_lo + region.box_hi);
+  const double reach = 0.5 * (region.box_hi - region.box_lo).norm();
+  const Eigen::Vector2d to_box = centre - from;
   const double distance = to_box.norm();
-  if (distance <= reach) return true;
-  const double spread = std::asin(reach / distance);
-  const double wanted = heading.Mid() - bearing_ + kPi;
-  const double offset = std::abs(WrapAngle(std::atan2(to_box.y(), to_box.x()) - wanted));
-  return offset <= spread + 0.5 * heading.Width() + margin_;
+  view.covers = distance <= reach;
+  if (view.covers) return view;
+  view.spread = std::asin(reach / distance);
+  view.direction = std::atan2(to_box.y(), to_box.x());
+  return view;
+}
+
+bool VerticalCut::MayMeet(const FeasibleRegion& in) const {
+  return MayMeet(in, [&] { return ViewBox(in, foot_); });
 }
 
 bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
@@ -356,19 +360,11 @@ bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double he
   if (count == 0) return false;
   for (const HeadingBin& bin : region.bins) {
     if (!Overlaps(bin, parts, count)) continue;
+    if (bin.positions.Empty()) continue;
+    // The band's own pass over the vertices gave the range of s (the bounding-box rejection
+    // that stood here cannot change this test's answer).
     const Band band = NonVerticalBand(line, edge, height, sigmas, bin);
-    if (bin.positions.Empty() ||
-        bin.positions.MaxSideBound(band.normal, band.offset + band.half_width) < 0.0 ||
-        bin.positions.MaxSideBound(-band.normal, band.half_width - band.offset) < 0.0) {
-      continue;
-    }
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Eigen::Vector2d& q : bin.positions) {
-      const double s = band.normal.dot(q) + band.offset;
-      lo = std::min(lo, s);
-      hi = std::max(hi, s);
-    }
-    if (hi >= -band.half_width && lo <= band.half_width) return true;
+    if (band.hi >= -band.half_width && band.lo <= band.half_width) return true;
   }
   return false;
 }
@@ -397,14 +393,7 @@ bool AddVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,
 }
 
 bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region) {
-  if (region.bins.size() > 4 && !cut.MayMeet(region)) return false;
-  for (const HeadingBin& bin : region.bins) {
-    Eigen::Vector2d n1, n2;
-    double d1 = 0.0, d2 = 0.0;
-    if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
-    if (bin.positions.MeetsBoth(n1, d1, n2, d2)) return true;
-  }
-  return false;
+  return MeetsVertical(cut, region, [&] { return ViewBox(region, cut.foot()); });
 }
 
 bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigmas,

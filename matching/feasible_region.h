@@ -43,6 +43,9 @@ class ConvexPolygon {
   int size() const { return count_; }
   const Eigen::Vector2d* begin() const { return vertices_.data(); }
   const Eigen::Vector2d* end() const { return vertices_.data() + count_; }
+  // Bounding box of the vertices (exactly their least and greatest coordinates; empty: +inf, -inf).
+  const Eigen::Vector2d& box_lo() const { return lo_; }
+  const Eigen::Vector2d& box_hi() const { return hi_; }
   // Largest n . p + d over the bounding box, plus a rounding margin: when negative, n . v + d is
   // negative for every vertex v as computed (a cheap rejection that cannot change a decision).
   double MaxSideBound(const Eigen::Vector2d& n, double d) const {
@@ -78,6 +81,17 @@ class ConvexPolygon {
 
 // Positions possible for headings in [lo, hi]; (cos, sin) of lo, mid and hi cached.
 struct HeadingBin {
+  // User-provided, so appending a bin to a vector does not zero the polygon's unused vertices
+  // (value-initialisation of an aggregate would: about 600 bytes per bin of every cut).
+  HeadingBin() {}
+  HeadingBin(double lo, double hi, const Eigen::Vector2d& trig_lo, const Eigen::Vector2d& trig_mid,
+             const Eigen::Vector2d& trig_hi, const ConvexPolygon& positions)
+      : lo(lo),
+        hi(hi),
+        trig_lo(trig_lo),
+        trig_mid(trig_mid),
+        trig_hi(trig_hi),
+        positions(positions) {}
   double lo = 0.0, hi = 0.0;
   Eigen::Vector2d trig_lo, trig_mid, trig_hi;
   ConvexPolygon positions;
@@ -125,6 +139,15 @@ bool AddNonVertical(const ObservedLine& line, const MatchEdge& edge, double heig
 bool MeetsNonVertical(const ObservedLine& line, const MatchEdge& edge, double height, double sigmas,
                       const FeasibleRegion& region);
 
+// The region's bounding box as seen from a point (a vertical edge's foot): whether the point is
+// within its circumscribed disk, else the direction to the box centre and the half-angle the disk
+// subtends (radians). The same for every line matched to that edge, so computed once per edge.
+struct BoxView {
+  bool covers = false;
+  double direction = 0.0, spread = 0.0;
+};
+BoxView ViewBox(const FeasibleRegion& region, const Eigen::Vector2d& from);
+
 // A vertical correspondence as a cut of the region: in a bin of headings [lo, hi] the camera
 // lies in the wedge of directions (h - w) + pi from the edge's foot, h in the bin, widened by
 // sigmas times the bearing noise. Built once per (line, edge) pair for many cuts.
@@ -149,6 +172,19 @@ class VerticalCut {
   // Quick test: the directions from the foot to the region's bounding box meet those the
   // headings allow (false: the cut empties the region).
   bool MayMeet(const FeasibleRegion& region) const;
+  // The same with `view()` returning ViewBox(region, foot()), called only when needed.
+  template <typename ViewFn>
+  bool MayMeet(const FeasibleRegion& region, ViewFn&& view) const {
+    if (region.Empty()) return false;
+    const HeadingInterval heading = region.Heading();
+    if (heading.Width() + 2.0 * margin_ >= kPi) return true;
+    const BoxView box = view();
+    if (box.covers) return true;
+    const double wanted = heading.Mid() - bearing_ + kPi;
+    const double offset = std::abs(WrapAngle(box.direction - wanted));
+    return offset <= box.spread + 0.5 * heading.Width() + margin_;
+  }
+  const Eigen::Vector2d& foot() const { return foot_; }
 
  private:
   Eigen::Vector2d foot_;
@@ -169,5 +205,18 @@ bool MeetsVertical(const ObservedLine& line, const MatchEdge& edge, double sigma
 // The same with the cut built beforehand.
 bool AddVertical(const VerticalCut& cut, const FeasibleRegion& in, FeasibleRegion* out);
 bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region);
+// The same with ViewBox(region, cut.foot()) given (shared by the cuts of one edge); `view` is
+// called only when needed and must return the same view each time.
+template <typename ViewFn>
+bool MeetsVertical(const VerticalCut& cut, const FeasibleRegion& region, ViewFn&& view) {
+  if (region.bins.size() > 4 && !cut.MayMeet(region, view)) return false;
+  for (const HeadingBin& bin : region.bins) {
+    Eigen::Vector2d n1, n2;
+    double d1 = 0.0, d2 = 0.0;
+    if (!cut.In(bin, &n1, &d1, &n2, &d2)) return true;
+    if (bin.positions.MeetsBoth(n1, d1, n2, d2)) return true;
+  }
+  return false;
+}
 
 }  // namespace linetrack

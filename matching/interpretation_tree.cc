@@ -230,6 +230,11 @@ class TreeSearch {
     const std::vector<char>& in = alive_[depth];
     std::vector<char>& out = alive_[depth + 1];
     const bool vertical = edges_[edge].vertical;
+    if (views_.size() != edges_.size()) {
+      views_.resize(edges_.size());
+      view_stamp_.assign(edges_.size(), -1);
+    }
+    ++forward_checks_;
     for (size_t j = 0; j < lines_.size(); ++j) {
       const bool assigned = decided_[j] >= 0;
       for (int c = line_offsets_[j]; c < line_offsets_[j + 1]; ++c) {
@@ -243,7 +248,17 @@ class TreeSearch {
                                           options_.gate_sigmas)) {
             continue;
           }
-          out[c] = MeetsVertical(*cuts_[c], region) ? 1 : 0;
+          const int foot = candidate_edge_[c];
+          out[c] = MeetsVertical(*cuts_[c], region,
+                                 [&]() -> const BoxView& {
+                                   if (view_stamp_[foot] != forward_checks_) {
+                                     views_[foot] = ViewBox(region, e.foot);
+                                     view_stamp_[foot] = forward_checks_;
+                                   }
+                                   return views_[foot];
+                                 })
+                       ? 1
+                       : 0;
         } else {
           out[c] = MeetsNonVertical(l, e, prior_.height, options_.gate_sigmas, region) ? 1 : 0;
         }
@@ -361,6 +376,11 @@ class TreeSearch {
   // Candidates by line: line j holds [line_offsets_[j], line_offsets_[j + 1]).
   std::vector<int> line_offsets_, candidate_edge_, candidate_line_;
   std::vector<std::optional<VerticalCut>> cuts_;  // vertical candidates' cuts
+  // ForwardCheck's views of the region's box from each vertical edge's foot, valid while
+  // view_stamp_[edge] == forward_checks_ (shared by the lines matched to the edge).
+  std::vector<BoxView> views_;
+  std::vector<long> view_stamp_;
+  long forward_checks_ = 0;
   // alive_[d][c]: candidate c is still consistent with the region at depth d (forward checking).
   std::vector<std::vector<char>> alive_;
   std::vector<int> decided_;     // per line: assigned candidate, kUndecided or kClutter
