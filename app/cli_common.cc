@@ -30,7 +30,7 @@ std::vector<double> ParseNumberList(const std::string& text, size_t count, const
       throw InputError(flag + ": not a finite number: '" + field + "' in '" + text + "'");
     }
   }
-  if (values.size() != count)
+  if (values.size() != count || (!text.empty() && text.back() == ','))
     throw InputError(flag + ": expected " + form + ", got '" + text + "'");
   return values;
 }
@@ -41,23 +41,8 @@ Pose3Dof ParsePrior(const std::string& text, const std::string& flag) {
 }
 
 std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag) {
-  std::stringstream in(text);
-  std::string field;
-  std::vector<double> values;
-  while (std::getline(in, field, ',')) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(field, &used));
-      if (used != field.size() || !std::isfinite(values.back())) throw std::invalid_argument(field);
-    } catch (const std::exception&) {
-      throw InputError(flag + ": not a finite number: '" + field + "' in '" + text + "'");
-    }
-  }
-  if (static_cast<int>(values.size()) != count || (!text.empty() && text.back() == ',')) {
-    throw InputError(flag + ": expected " + std::to_string(count) +
-                     " comma-separated numbers, got '" + text + "'");
-  }
-  return values;
+  return ParseNumberList(text, static_cast<size_t>(count), flag,
+                         std::to_string(count) + " comma-separated numbers");
 }
 
 void CheckRange(double value, double lo, double hi, const std::string& flag) {

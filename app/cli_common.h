@@ -20,8 +20,8 @@ constexpr int kExitBadInput = 2;   // bad usage or bad input (one line on stderr
 // What a chosen subcommand runs after parsing; returns the exit code.
 using CommandAction = std::function<int()>;
 
-// Parses `count` comma-separated finite numbers ("1.5,2,-3"); `form` names them in errors
-// (e.g. "X,Y,Z"). Throws InputError naming `flag` when malformed.
+// Parses `count` comma-separated finite numbers ("1.5,2,-3"; no empty or trailing field); `form`
+// names them in errors (e.g. "X,Y,Z"). Throws InputError naming `flag` when malformed.
 std::vector<double> ParseNumberList(const std::string& text, size_t count, const std::string& flag,
                                     const std::string& form);
 
@@ -29,7 +29,7 @@ std::vector<double> ParseNumberList(const std::string& text, size_t count, const
 // Throws InputError naming `flag` when malformed or not finite.
 Pose3Dof ParsePrior(const std::string& text, const std::string& flag);
 
-// Parses `count` comma-separated finite numbers; throws InputError naming `flag` otherwise.
+// ParseNumberList with errors saying "`count` comma-separated numbers".
 std::vector<double> ParseNumbers(const std::string& text, int count, const std::string& flag);
 
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).

@@ -1,0 +1,26 @@
+// Pieces of the verification shared by its two source files (verification.cc and
+// hypothesis_trimming.cc); not part of the matching library's interface.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "matching/pose_refinement.h"
+#include "matching/verification.h"
+
+namespace linetrack {
+
+// Pairs as LineMatches whitened by the noise model with levers from the segment's own middle
+// (the projection is not known yet).
+std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
+                                     const std::vector<std::pair<int, int>>& pairs);
+
+// Wilson-Hilferty approximation of the chi-square quantile with `dof` degrees of freedom at
+// standard normal quantile z.
+double ChiSquareQuantile(double dof, double z);
+
+// Standard normal quantile for p in (0.975, 1) (Acklam's rational approximation, upper tail;
+// relative error below 1.2e-9).
+double NormalQuantile(double p);
+
+}  // namespace linetrack
