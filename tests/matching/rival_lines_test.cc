@@ -85,7 +85,9 @@ class RivalLinesTest : public ::testing::Test {
          PairsBeatingRivalLines(context, options_, Verified(context, scene, scene.matches))) {
       if (scene.lines[pair.second].Length() < kMinLinePx) continue;
       std::vector<std::pair<int, int>> others = scene.matches;
-      others.erase(std::find(others.begin(), others.end(), pair));
+      const auto it = std::find(others.begin(), others.end(), pair);
+      if (it == others.end()) continue;  // guided matching's pair, not one of the truth's
+      others.erase(it);
       const double sigma = RefineHypothesis(context, others, {scene.truth.Planar()}, options_)
                                .refinement.position_sigma_m;
       if (sigma < best_sigma) {
@@ -158,9 +160,9 @@ TEST_F(RivalLinesTest, AStandInForAnUndetectedImageIsNotReportedAtThePoseOfTheOt
     const VerificationContext exact = Context(scene, scene.lines);
     const VerifiedPose truth =
         RefineHypothesis(exact, scene.matches, {scene.truth.Planar()}, options_);
-    const size_t index = static_cast<size_t>(
-        std::find(truth.pairs.begin(), truth.pairs.end(), std::make_pair(edge, line)) -
-        truth.pairs.begin());
+    const auto it = std::find(truth.pairs.begin(), truth.pairs.end(), std::make_pair(edge, line));
+    ASSERT_NE(it, truth.pairs.end()) << "scene " << scene.index;
+    const size_t index = static_cast<size_t>(it - truth.pairs.begin());
     Pose3Dof others;
     Eigen::Matrix4d covariance;
     ASSERT_TRUE(DeletedPose(exact, truth, index, &others, &covariance));
