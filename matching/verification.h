@@ -182,7 +182,7 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
 // the edge, or the two are not collinear fragments), e.g. a door casing's border or a box's
 // bottom beside the edge. When the edge has other lines there that are fragments of the same
 // image, the pair's line must also beat clutter at that pose: a further fragment beside them
-// must stand without pulling the pose toward itself (docs/matching.md, section 3).
+// must stand without pulling the pose toward itself (docs/matching.md, section 7).
 std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
                                                         const VerificationOptions& options,
                                                         const VerifiedPose& verified);
