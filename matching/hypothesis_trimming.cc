@@ -149,7 +149,7 @@ int OutlyingPair(const VerificationContext& context, const VerificationOptions& 
 }
 
 bool DeletedPose(const VerificationContext& context, const VerifiedPose& verified, size_t i,
-                 Pose3Dof* pose) {
+                 Pose3Dof* pose, Eigen::Matrix4d* covariance) {
   *pose = verified.pose;
   const LineMatch match = ToLineMatches(context, {verified.pairs.at(i)}).front();
   Eigen::Matrix<double, 2, 4> j;
@@ -162,10 +162,13 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
   if (!(complement.determinant() > 1e-6)) return false;
   // Sherman-Morrison-Woodbury on the normal equations (J = d residual / d pose, whitened):
   // delta = C J_i' (I - H_ii)^-1 r_i.
-  const Eigen::Vector4d delta = c * wj.transpose() * complement.inverse() * r;
+  const Eigen::Matrix2d complement_inverse = complement.inverse();
+  const Eigen::Vector4d delta = c * wj.transpose() * complement_inverse * r;
   pose->heading += delta(0);
   pose->x += delta(1);
   pose->y += delta(2);
+  // The same identity for the covariance: (C^-1 - J_i' J_i)^-1 = C + C J_i' (I - H_ii)^-1 J_i C.
+  if (covariance != nullptr) *covariance = c + c * wj.transpose() * complement_inverse * wj * c;
   return true;
 }
 

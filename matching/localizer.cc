@@ -301,8 +301,10 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
         "weak evidence (" + std::to_string(score) + " of " + std::to_string(required) + " nats)";
     return;
   }
+  // Only correspondences that also beat every rival line at the pose of the others are reported.
+  const std::vector<std::pair<int, int>> reported = PairsBeatingRivalLines(context, vo, best);
   std::set<int> confident_edges;
-  for (const auto& pair : best.confident_pairs)
+  for (const auto& pair : reported)
     confident_edges.insert(pair.first);
   if (static_cast<int>(confident_edges.size()) < vo.min_confident_edges) {
     result.reason =
@@ -312,7 +314,10 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.found = true;
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
-  for (const auto& [e, l] : best.confident_pairs)
+  result.covariance = best.refinement.covariance.topLeftCorner<3, 3>();
+  result.position_sigma_m = best.refinement.position_sigma_m;
+  result.heading_sigma_rad = best.refinement.heading_sigma_rad;
+  for (const auto& [e, l] : reported)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());
 }

@@ -78,6 +78,13 @@ struct LocalizationResult {
   bool budget_exhausted = false;
   std::string reason;               // why no pose was accepted (empty when found)
   std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first
+  // Uncertainty of the accepted pose under the line noise model (valid when found): covariance
+  // of (heading rad, x m, y m), the focal scale marginalised; its largest position axis (m) and
+  // heading standard deviation (rad). When the noise model holds, the truth's squared
+  // Mahalanobis distance from the pose is chi2(3) distributed (docs/matching.md).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double position_sigma_m = 0.0;
+  double heading_sigma_rad = 0.0;
 };
 
 class Localizer {

@@ -168,10 +168,24 @@ int OutlyingPair(const VerificationContext& context, const VerificationOptions& 
                  const VerifiedPose& hypothesis);
 
 // The pose a refined hypothesis' pairs give without pair i, to first order: pose + C J_i'
-// (I - H_ii)^-1 r_i (whitened residuals r_i, Jacobian J_i, leverage H_ii = J_i C J_i'). False
-// (pose unchanged) when pair i alone fixes a direction of the pose (H_ii near the identity).
+// (I - H_ii)^-1 r_i (whitened residuals r_i, Jacobian J_i, leverage H_ii = J_i C J_i'), and
+// when `covariance` is given its covariance C + C J_i' (I - H_ii)^-1 J_i C (heading, x, y,
+// scale). False (pose unchanged) when pair i alone fixes a direction of the pose (H_ii near the
+// identity).
 bool DeletedPose(const VerificationContext& context, const VerifiedPose& verified, size_t i,
-                 Pose3Dof* pose);
+                 Pose3Dof* pose, Eigen::Matrix4d* covariance = nullptr);
+
+// The reported correspondences of a verified pose: those of its confident_pairs that, at the
+// pose of its other pairs (DeletedPose, with that pose's covariance), are within the gates and
+// beat by report_nats every other edge for the line and every rival line for the edge: another
+// line that fits the edge there and cannot be the same image (it overlaps the pair's line along
+// the edge, or the two are not collinear fragments), e.g. a door casing's border or a box's
+// bottom beside the edge. When the edge has other lines there that are fragments of the same
+// image, the pair's line must also beat clutter at that pose: a further fragment beside them
+// must stand without pulling the pose toward itself (docs/matching.md, section 7).
+std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
+                                                        const VerificationOptions& options,
+                                                        const VerifiedPose& verified);
 
 // The poses a verified pose's pairs give without one of its influential pairs (the first-order
 // deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the

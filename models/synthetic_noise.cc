@@ -87,7 +87,9 @@ bool SyntheticSceneOptions::Check(std::string* why) const {
       !GoodRange(vertical_clutter_height_min, vertical_clutter_height_max, 0.0,
                  "vertical clutter height (m)", why) ||
       !GoodRange(clutter_length_min_px, clutter_length_max_px, 1e-6, "clutter length (px)", why) ||
-      !GoodRange(delta_t, delta_t, 0.0, "delta_t (m)", why)) {
+      !GoodRange(delta_t, delta_t, 0.0, "delta_t (m)", why) ||
+      !GoodRange(parallel_offset_min_px, parallel_offset_max_px, 0.0, "parallel offset (px)",
+                 why)) {
     return false;
   }
   if (shorten_max >= 0.5 || split_probability > 1.0 || split_gap >= 0.5 ||
@@ -100,7 +102,8 @@ bool SyntheticSceneOptions::Check(std::string* why) const {
     return false;
   }
   if (!GoodCount(min_visible_edges, max_visible_edges, "visible edges per scene", why) ||
-      !GoodCount(min_clutter, max_clutter, "clutter lines per scene", why)) {
+      !GoodCount(min_clutter, max_clutter, "clutter lines per scene", why) ||
+      !GoodCount(parallel_clutter, parallel_clutter, "parallel clutter lines per scene", why)) {
     return false;
   }
   if (max_visible_edges == 0 || max_attempts <= 0) {

@@ -135,6 +135,32 @@ std::vector<LabelledLine> ModelLines(const WireframeModel& model, const Occlusio
   return lines;
 }
 
+// `count` lines parallel to model lines of `lines` (SyntheticSceneOptions::parallel_clutter),
+// appended as clutter; drawn from `rng`, a stream of their own.
+void AddParallelClutter(int count, const SyntheticSceneOptions& o, SceneRandom* rng,
+                        std::vector<LabelledLine>* lines) {
+  std::vector<Segment2> model_lines;
+  for (const LabelledLine& line : *lines) {
+    if (line.edge_id >= 0) model_lines.push_back(line.line);
+  }
+  if (model_lines.empty()) return;
+  for (int k = 0; k < count; ++k) {
+    const Segment2& beside = model_lines[rng->Integer(0, static_cast<int>(model_lines.size()) - 1)];
+    const double offset = rng->Uniform(o.parallel_offset_min_px, o.parallel_offset_max_px) *
+                          (rng->Bernoulli(0.5) ? 1.0 : -1.0);
+    const double share = rng->Uniform(0.3, 1.0);
+    const double start = rng->Uniform(0.0, 1.0 - share);
+    const Segment2 stretch{beside.a + start * (beside.b - beside.a),
+                           beside.a + (start + share) * (beside.b - beside.a)};
+    Segment2 twin = PerturbSegment(stretch, rng->Normal(o.angle_sigma),
+                                   offset + rng->Normal(o.offset_sigma_px));
+    if (ClipSegmentToImage(o.camera.width, o.camera.height, &twin) &&
+        twin.Length() >= o.min_length_px) {
+      lines->push_back({twin, -1, false});
+    }
+  }
+}
+
 // Shuffles the lines (Fisher-Yates) and fills the scene's lines and ground truth.
 void AssembleLines(std::vector<LabelledLine> lines, SceneRandom* rng, SyntheticScene* scene) {
   for (int i = static_cast<int>(lines.size()) - 1; i > 0; --i) {
@@ -196,6 +222,10 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
   scene.delta_phi = o.delta_phi;
   scene.height = scene.truth.height;
   scene.tilt = scene.truth.tilt;
+  if (o.parallel_clutter > 0) {
+    SceneRandom parallel(o.seed ^ 0x9e3779b97f4a7c15ULL, static_cast<uint64_t>(index));
+    AddParallelClutter(o.parallel_clutter, o, &parallel, &lines);
+  }
   AssembleLines(std::move(lines), &rng, &scene);
   return scene;
 }

@@ -67,6 +67,13 @@ struct SyntheticSceneOptions {
   double vertical_clutter_distance_min = 1.0, vertical_clutter_distance_max = 6.0;
   double vertical_clutter_height_min = 0.3, vertical_clutter_height_max = 1.5;
   double clutter_length_min_px = 20.0, clutter_length_max_px = 200.0;
+  // Near-parallel unmodelled lines (door casings, boxes against walls): parallel_clutter lines
+  // per scene, each beside a model line of the scene (chosen uniformly) at a perpendicular
+  // offset U(parallel_offset_min_px, parallel_offset_max_px) on a random side, over a random
+  // stretch (U(0.3, 1) of it), with their own line noise. Drawn from a separate random stream:
+  // with 0 (the default) the scenes are those without the option.
+  int parallel_clutter = 0;
+  double parallel_offset_min_px = 2.0, parallel_offset_max_px = 8.0;
   // Prior bounds (default QI1); the prior position is uniform in the disk of radius delta_t
   // around the truth, the prior heading uniform within +-delta_phi of the true heading.
   double delta_t = 0.30;

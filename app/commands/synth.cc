@@ -35,6 +35,7 @@ struct SynthCommandOptions {
   double calibration_sigma = SyntheticSceneOptions().calibration_sigma;
   double angle_sigma_deg = RadToDeg(SyntheticSceneOptions().angle_sigma);
   double offset_sigma_px = SyntheticSceneOptions().offset_sigma_px;
+  int parallel_clutter = 0;  // near-parallel unmodelled lines per scene (0: none)
   bool exact = false;
 };
 
@@ -111,6 +112,7 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   o.angle_sigma = opt.exact ? 0.0 : DegToRad(opt.angle_sigma_deg);
   o.offset_sigma_px = opt.exact ? 0.0 : opt.offset_sigma_px;
   if (opt.exact) o.shorten_max = o.split_probability = 0.0;
+  o.parallel_clutter = opt.parallel_clutter;
   if (!opt.camera_path.empty()) {
     o.camera = ReadCameraXml(opt.camera_path);
     if (o.camera.width <= 0 || o.camera.height <= 0) {
@@ -252,6 +254,9 @@ void AddSynth(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--offset-sigma", opt->offset_sigma_px, "Std of the line offset noise (pixels)")
       ->capture_default_str();
   cmd->add_flag("--exact", opt->exact, "No calibration error, line noise or fragmentation");
+  cmd->add_option("--parallel-clutter", opt->parallel_clutter,
+                  "Unmodelled lines per scene 2-8 px beside model lines (door casings, boxes "
+                  "against walls; default none)");
   cmd->callback([opt, action, cmd] {
     opt->has_delta_t = cmd->count("--delta-t") > 0;
     opt->has_delta_phi = cmd->count("--delta-phi") > 0;
