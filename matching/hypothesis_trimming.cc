@@ -33,6 +33,10 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
         double chi2 = 0.0;
         const PoseView view = ViewOf(candidate, context.height, context.tilt);
         for (size_t k = 0; k < matches.size(); ++k) {
+          // Stop when this pose can no longer beat the best one (more inliers, or as many with a
+          // smaller chi-square): the result is the same.
+          const size_t most = inliers.size() + (matches.size() - k);
+          if (most < best.size() || (most == best.size() && chi2 >= best_chi2)) break;
           const double c = (matches[k].whitening *
                             EndpointResiduals(matches[k], *context.camera, view, 1.0, nullptr))
                                .squaredNorm();

@@ -181,10 +181,17 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     bool improved = false;
     Eigen::Vector4d step = Eigen::Vector4d::Zero();
     for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
-      Eigen::MatrixXd damped = jtj.topLeftCorner(dof, dof);
-      damped.diagonal() *= 1.0 + lambda;
-      damped.diagonal().array() += 1e-12;
-      step.head(dof) = -damped.ldlt().solve(jtr.head(dof));
+      // The damped step, solved at fixed size (no allocation).
+      auto damped_step = [&](auto damped, const auto& gradient) {
+        damped.diagonal() *= 1.0 + lambda;
+        damped.diagonal().array() += 1e-12;
+        return (-damped.ldlt().solve(gradient)).eval();
+      };
+      if (with_scale) {
+        step = damped_step(Eigen::Matrix4d(jtj), jtr);
+      } else {
+        step.head<3>() = damped_step(Eigen::Matrix3d(jtj.topLeftCorner<3, 3>()), jtr.head<3>());
+      }
       const Pose3Dof trial{result.pose.x + step[1], result.pose.y + step[2],
                            result.pose.heading + step[0]};
       const double trial_scale = result.focal_scale + step[3];
