@@ -71,7 +71,13 @@ struct VerificationOptions {
   double prior_margin_deg = 0.5;
   double prior_margin_sigmas = 3.0;
   double wall_margin_m = 0.1;  // and must be this far from walls and obstacles
-  PoseRefinementOptions refinement;
+  // Levenberg-Marquardt of the hypotheses, stopping at steps below 1e-4 (0.1 mm, 0.006 degrees,
+  // far below the poses' noise) instead of converging to rounding: fewer iterations per leaf.
+  PoseRefinementOptions refinement = [] {
+    PoseRefinementOptions o;
+    o.step_tolerance = 1e-4;
+    return o;
+  }();
 
   bool Check(std::string* why) const;
 };
