@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "matching/verification.h"
 #include "matching/verification_internal.h"
@@ -22,24 +23,43 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
   std::vector<std::pair<int, int>> best;
   double best_chi2 = 0.0;
   std::vector<std::pair<int, int>> inliers;
+  ConsensusMemo::Entry local;
   for (size_t i = 0; i < pairs.size(); ++i) {
     for (size_t j = i + 1; j < pairs.size(); ++j) {
       const auto [e1, l1] = pairs[i];
       const auto [e2, l2] = pairs[j];
-      for (const Pose3Dof& candidate :
-           MinimalPoses((*context.lines)[l1], (*context.edges)[e1], (*context.lines)[l2],
-                        (*context.edges)[e2], context.height)) {
+      ConsensusMemo::Entry* entry = &local;
+      bool fresh = true;
+      if (context.consensus_memo != nullptr) {
+        const auto [it, inserted] = context.consensus_memo->entries.try_emplace(
+            {ConsensusMemo::PairKey(pairs[i]), ConsensusMemo::PairKey(pairs[j])});
+        entry = &it->second;
+        fresh = inserted;
+      }
+      if (fresh) {
+        entry->poses = MinimalPoses((*context.lines)[l1], (*context.edges)[e1],
+                                    (*context.lines)[l2], (*context.edges)[e2], context.height);
+        entry->chi2.assign(entry->poses.size(), {});
+      }
+      for (size_t p = 0; p < entry->poses.size(); ++p) {
+        const Pose3Dof& candidate = entry->poses[p];
         inliers.clear();
         double chi2 = 0.0;
-        const PoseView view = ViewOf(candidate, context.height, context.tilt);
+        std::optional<PoseView> view;
         for (size_t k = 0; k < matches.size(); ++k) {
           // Stop when this pose can no longer beat the best one (more inliers, or as many with a
           // smaller chi-square): the result is the same.
           const size_t most = inliers.size() + (matches.size() - k);
           if (most < best.size() || (most == best.size() && chi2 >= best_chi2)) break;
-          const double c = (matches[k].whitening *
-                            EndpointResiduals(matches[k], *context.camera, view, 1.0, nullptr))
-                               .squaredNorm();
+          const auto [it, inserted] =
+              entry->chi2[p].try_emplace(ConsensusMemo::PairKey(pairs[k]), 0.0);
+          if (inserted) {
+            if (!view) view = ViewOf(candidate, context.height, context.tilt);
+            it->second = (matches[k].whitening *
+                          EndpointResiduals(matches[k], *context.camera, *view, 1.0, nullptr))
+                             .squaredNorm();
+          }
+          const double c = it->second;
           if (c > options.consensus_chi2) continue;
           inliers.push_back(pairs[k]);
           chi2 += c;

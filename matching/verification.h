@@ -5,7 +5,9 @@
 // result scored as a log-likelihood ratio against "every line is clutter" (docs/matching.md).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -82,6 +84,27 @@ struct VerificationOptions {
   bool Check(std::string* why) const;
 };
 
+// The consensus restart's minimal poses of two pairs and the whitened chi-square of a third pair
+// at each, memoised over the hypotheses of one localisation (sibling leaves of the tree share
+// most of their pairs). Keys are (edge index, line index) pairs; values are exactly those
+// computed without the memo.
+struct ConsensusMemo {
+  struct Entry {
+    std::vector<Pose3Dof> poses;
+    std::vector<std::unordered_map<uint64_t, double>> chi2;  // per pose, by PairKey of the third
+  };
+  struct Hash {
+    size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
+      return std::hash<uint64_t>()(k.first * 0x9E3779B97F4A7C15ULL ^ k.second);
+    }
+  };
+  static uint64_t PairKey(const std::pair<int, int>& pair) {
+    return (static_cast<uint64_t>(static_cast<uint32_t>(pair.first)) << 32) |
+           static_cast<uint32_t>(pair.second);
+  }
+  std::unordered_map<std::pair<uint64_t, uint64_t>, Entry, Hash> entries;
+};
+
 // What a localisation problem looks like to the verifier.
 struct VerificationContext {
   const std::vector<MatchEdge>* edges = nullptr;  // candidate edges
@@ -100,6 +123,8 @@ struct VerificationContext {
   long* pair_tests = nullptr;
   // When set, a pair (edge index, line index) guided matching may not use (a rival without it).
   std::pair<int, int> excluded_pair = {-1, -1};
+  // When set, TrimHypothesis' consensus restart reads and fills this memo.
+  ConsensusMemo* consensus_memo = nullptr;
 };
 
 // Evidence for a pose (nats): the log-likelihood ratio of the observed lines under "the camera is
