@@ -79,6 +79,24 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
 
 namespace {
 
+// Levenberg-Marquardt on `pairs` from (start, scale); read from and added to the context's memo
+// when it has one (the trimming of sibling leaves refits the same pairs from the same starts).
+PoseRefinementResult Refit(const VerificationContext& context, const VerificationOptions& options,
+                           const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                           double scale) {
+  auto refine = [&] {
+    return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
+                      start, scale, options.refinement);
+  };
+  if (context.consensus_memo == nullptr) return refine();
+  ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
+  const auto found = context.consensus_memo->refits.find(key);
+  if (found != context.consensus_memo->refits.end()) return found->second;
+  const PoseRefinementResult result = refine();
+  context.consensus_memo->refits.emplace(std::move(key), result);
+  return result;
+}
+
 // The chi-square test of a hypothesis as a whole, restored by the consensus restart and the
 // trimming of the largest residual (TrimHypothesis without the per-pair test).
 bool RestoreConsistency(const VerificationContext& context, const VerificationOptions& options,
@@ -92,8 +110,7 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
         Consensus(context, options, hypothesis->pairs, &start);
     if (agreeing.size() < 3) return false;
     hypothesis->pairs = std::move(agreeing);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, start, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, start, 1.0);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   while (!ConsistentHypothesis(*hypothesis, options)) {
@@ -113,9 +130,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
       }
     }
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, hypothesis->pose,
-                                        hypothesis->refinement.focal_scale, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
+                                   hypothesis->refinement.focal_scale);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   // Pairs dropped on the way that fit the consistent pose are taken back (the minimal pose of the
@@ -135,9 +151,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
       if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
     }
     if (trial.pairs.size() == hypothesis->pairs.size()) break;
-    trial.refinement = RefinePose(ToLineMatches(context, trial.pairs), *context.camera,
-                                  context.height, context.tilt, hypothesis->pose,
-                                  hypothesis->refinement.focal_scale, options.refinement);
+    trial.refinement =
+        Refit(context, options, trial.pairs, hypothesis->pose, hypothesis->refinement.focal_scale);
     trial.pose = trial.refinement.pose;
     if (!ConsistentHypothesis(trial, options)) break;
     *hypothesis = std::move(trial);
@@ -231,9 +246,8 @@ bool TrimHypothesis(const VerificationContext& context, const VerificationOption
        worst = OutlyingPair(context, options, *hypothesis)) {
     if (hypothesis->pairs.size() <= 3) return false;
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, hypothesis->pose,
-                                        hypothesis->refinement.focal_scale, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
+                                   hypothesis->refinement.focal_scale);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   return true;

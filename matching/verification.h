@@ -5,7 +5,9 @@
 // result scored as a log-likelihood ratio against "every line is clutter" (docs/matching.md).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -85,9 +87,9 @@ struct VerificationOptions {
 };
 
 // The consensus restart's minimal poses of two pairs and the whitened chi-square of a third pair
-// at each, memoised over the hypotheses of one localisation (sibling leaves of the tree share
-// most of their pairs). Keys are (edge index, line index) pairs; values are exactly those
-// computed without the memo.
+// at each, and the trimming's refits, memoised over the hypotheses of one localisation (sibling
+// leaves of the tree share most of their pairs). Keys are (edge index, line index) pairs; values
+// are exactly those computed without the memo.
 struct ConsensusMemo {
   struct Entry {
     std::vector<Pose3Dof> poses;
@@ -103,6 +105,9 @@ struct ConsensusMemo {
            static_cast<uint32_t>(pair.second);
   }
   std::unordered_map<std::pair<uint64_t, uint64_t>, Entry, Hash> entries;
+  // Levenberg-Marquardt refits of the trimming: by (pairs, start x, y, heading, focal scale).
+  using RefitKey = std::pair<std::vector<std::pair<int, int>>, std::array<double, 4>>;
+  std::map<RefitKey, PoseRefinementResult> refits;
 };
 
 // What a localisation problem looks like to the verifier.
