@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "matching/verification.h"
 #include "matching/verification_internal.h"
@@ -22,20 +23,43 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
   std::vector<std::pair<int, int>> best;
   double best_chi2 = 0.0;
   std::vector<std::pair<int, int>> inliers;
+  ConsensusMemo::Entry local;
   for (size_t i = 0; i < pairs.size(); ++i) {
     for (size_t j = i + 1; j < pairs.size(); ++j) {
       const auto [e1, l1] = pairs[i];
       const auto [e2, l2] = pairs[j];
-      for (const Pose3Dof& candidate :
-           MinimalPoses((*context.lines)[l1], (*context.edges)[e1], (*context.lines)[l2],
-                        (*context.edges)[e2], context.height)) {
+      ConsensusMemo::Entry* entry = &local;
+      bool fresh = true;
+      if (context.consensus_memo != nullptr) {
+        const auto [it, inserted] = context.consensus_memo->entries.try_emplace(
+            {ConsensusMemo::PairKey(pairs[i]), ConsensusMemo::PairKey(pairs[j])});
+        entry = &it->second;
+        fresh = inserted;
+      }
+      if (fresh) {
+        entry->poses = MinimalPoses((*context.lines)[l1], (*context.edges)[e1],
+                                    (*context.lines)[l2], (*context.edges)[e2], context.height);
+        entry->chi2.assign(entry->poses.size(), {});
+      }
+      for (size_t p = 0; p < entry->poses.size(); ++p) {
+        const Pose3Dof& candidate = entry->poses[p];
         inliers.clear();
         double chi2 = 0.0;
-        const PoseView view = ViewOf(candidate, context.height, context.tilt);
+        std::optional<PoseView> view;
         for (size_t k = 0; k < matches.size(); ++k) {
-          const double c = (matches[k].whitening *
-                            EndpointResiduals(matches[k], *context.camera, view, 1.0, nullptr))
-                               .squaredNorm();
+          // Stop when this pose can no longer beat the best one (more inliers, or as many with a
+          // smaller chi-square): the result is the same.
+          const size_t most = inliers.size() + (matches.size() - k);
+          if (most < best.size() || (most == best.size() && chi2 >= best_chi2)) break;
+          const auto [it, inserted] =
+              entry->chi2[p].try_emplace(ConsensusMemo::PairKey(pairs[k]), 0.0);
+          if (inserted) {
+            if (!view) view = ViewOf(candidate, context.height, context.tilt);
+            it->second = (matches[k].whitening *
+                          EndpointResiduals(matches[k], *context.camera, *view, 1.0, nullptr))
+                             .squaredNorm();
+          }
+          const double c = it->second;
           if (c > options.consensus_chi2) continue;
           inliers.push_back(pairs[k]);
           chi2 += c;
@@ -55,6 +79,24 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
 
 namespace {
 
+// Levenberg-Marquardt on `pairs` from (start, scale); read from and added to the context's memo
+// when it has one (the trimming of sibling leaves refits the same pairs from the same starts).
+PoseRefinementResult Refit(const VerificationContext& context, const VerificationOptions& options,
+                           const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
+                           double scale) {
+  auto refine = [&] {
+    return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
+                      start, scale, options.refinement);
+  };
+  if (context.consensus_memo == nullptr) return refine();
+  ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
+  const auto found = context.consensus_memo->refits.find(key);
+  if (found != context.consensus_memo->refits.end()) return found->second;
+  const PoseRefinementResult result = refine();
+  context.consensus_memo->refits.emplace(std::move(key), result);
+  return result;
+}
+
 // The chi-square test of a hypothesis as a whole, restored by the consensus restart and the
 // trimming of the largest residual (TrimHypothesis without the per-pair test).
 bool RestoreConsistency(const VerificationContext& context, const VerificationOptions& options,
@@ -68,8 +110,7 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
         Consensus(context, options, hypothesis->pairs, &start);
     if (agreeing.size() < 3) return false;
     hypothesis->pairs = std::move(agreeing);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, start, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, start, 1.0);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   while (!ConsistentHypothesis(*hypothesis, options)) {
@@ -89,9 +130,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
       }
     }
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, hypothesis->pose,
-                                        hypothesis->refinement.focal_scale, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
+                                   hypothesis->refinement.focal_scale);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   // Pairs dropped on the way that fit the consistent pose are taken back (the minimal pose of the
@@ -111,9 +151,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
       if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
     }
     if (trial.pairs.size() == hypothesis->pairs.size()) break;
-    trial.refinement = RefinePose(ToLineMatches(context, trial.pairs), *context.camera,
-                                  context.height, context.tilt, hypothesis->pose,
-                                  hypothesis->refinement.focal_scale, options.refinement);
+    trial.refinement =
+        Refit(context, options, trial.pairs, hypothesis->pose, hypothesis->refinement.focal_scale);
     trial.pose = trial.refinement.pose;
     if (!ConsistentHypothesis(trial, options)) break;
     *hypothesis = std::move(trial);
@@ -210,9 +249,8 @@ bool TrimHypothesis(const VerificationContext& context, const VerificationOption
        worst = OutlyingPair(context, options, *hypothesis)) {
     if (hypothesis->pairs.size() <= 3) return false;
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = RefinePose(ToLineMatches(context, hypothesis->pairs), *context.camera,
-                                        context.height, context.tilt, hypothesis->pose,
-                                        hypothesis->refinement.focal_scale, options.refinement);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
+                                   hypothesis->refinement.focal_scale);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   return true;

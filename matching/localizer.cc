@@ -122,6 +122,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     std::vector<VerifiedBasin> basins;
     long pair_tests = 0;
     context.pair_tests = &pair_tests;
+    ConsensusMemo consensus_memo;
+    context.consensus_memo = &consensus_memo;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -179,6 +181,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
     }
     context.pair_tests = nullptr;
+    context.consensus_memo = nullptr;
   } else {
     BaselineStats stats;
     verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);

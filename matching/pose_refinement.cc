@@ -53,26 +53,26 @@ Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3
   // Line through the two projections in normalised coordinates, then in pixels: l_p = K^-T l_n,
   // K with focal lengths s px, s py; then scaled to a unit normal.
   const Eigen::Vector3d ln = xa.cross(xb);
-  const double fx = scale * camera.px, fy = scale * camera.py;
+  const double inv_fx = 1.0 / (scale * camera.px), inv_fy = 1.0 / (scale * camera.py);
   auto to_pixels = [&](const Eigen::Vector3d& l) {
-    return Eigen::Vector3d(l.x() / fx, l.y() / fy,
-                           l.z() - l.x() * camera.u0 / fx - l.y() * camera.v0 / fy);
+    const double p = l.x() * inv_fx, q = l.y() * inv_fy;
+    return Eigen::Vector3d(p, q, l.z() - p * camera.u0 - q * camera.v0);
   };
   const Eigen::Vector3d lp = to_pixels(ln);
-  const double norm = std::sqrt(lp.x() * lp.x() + lp.y() * lp.y());
-  const Eigen::Vector3d line = lp / norm;
+  const double inv_norm = 1.0 / std::sqrt(lp.x() * lp.x() + lp.y() * lp.y());
+  const Eigen::Vector3d line = lp * inv_norm;
   if (derivative) {
     // d (lp / |lp_uv|) = (dlp - line (line_uv . dlp_uv)) / |lp_uv|.
     auto column = [&](const Eigen::Vector3d& dlp, int k) {
-      derivative->col(k) = (dlp - line * (line.x() * dlp.x() + line.y() * dlp.y())) / norm;
+      derivative->col(k) = (dlp - line * (line.x() * dlp.x() + line.y() * dlp.y())) * inv_norm;
     };
     column(to_pixels((view.d_rotation * (a - view.centre)).cross(xb) +
                      xa.cross(view.d_rotation * (b - view.centre))),
            0);
-    for (int k = 1; k <= 2; ++k) {  // d x_a / dx = d x_b / dx = -rotation.col(0); y likewise
-      const Eigen::Vector3d d = -view.rotation.col(k - 1);
-      column(to_pixels(d.cross(xb) + xa.cross(d)), k);
-    }
+    // d x_a / dx = d x_b / dx = d = -rotation.col(0) (y likewise): d ln = d x (xb - xa).
+    const Eigen::Vector3d along = xb - xa;
+    for (int k = 1; k <= 2; ++k)
+      column(to_pixels(along.cross(view.rotation.col(k - 1))), k);
     // lp(s) = (p / s, q / s, l_z - (p u0 + q v0) / s): d lp / ds = -(lp - (0, 0, l_z)) / s.
     column(-(lp - Eigen::Vector3d(0.0, 0.0, ln.z())) / scale, 3);
   }
@@ -181,10 +181,17 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     bool improved = false;
     Eigen::Vector4d step = Eigen::Vector4d::Zero();
     for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
-      Eigen::MatrixXd damped = jtj.topLeftCorner(dof, dof);
-      damped.diagonal() *= 1.0 + lambda;
-      damped.diagonal().array() += 1e-12;
-      step.head(dof) = -damped.ldlt().solve(jtr.head(dof));
+      // The damped step, solved at fixed size (no allocation).
+      auto damped_step = [&](auto damped, const auto& gradient) {
+        damped.diagonal() *= 1.0 + lambda;
+        damped.diagonal().array() += 1e-12;
+        return (-damped.ldlt().solve(gradient)).eval();
+      };
+      if (with_scale) {
+        step = damped_step(Eigen::Matrix4d(jtj), jtr);
+      } else {
+        step.head<3>() = damped_step(Eigen::Matrix3d(jtj.topLeftCorner<3, 3>()), jtr.head<3>());
+      }
       const Pose3Dof trial{result.pose.x + step[1], result.pose.y + step[2],
                            result.pose.heading + step[0]};
       const double trial_scale = result.focal_scale + step[3];

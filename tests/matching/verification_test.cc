@@ -1,6 +1,7 @@
 // Verification of hypotheses on synthetic scenes of the hall: the first-order pose without one
 // pair (DeletedPose) against a refit, the per-pair outlier test (OutlyingPair) on true pairs and
-// on a wrong pair hidden among them, and the leave-one-out rivals of a well-determined pose.
+// on a wrong pair hidden among them, the leave-one-out rivals of a well-determined pose, and the
+// consensus memo (TrimHypothesis gives the same result with and without it).
 #include "matching/verification.h"
 
 #include <gtest/gtest.h>
@@ -121,6 +122,37 @@ TEST_F(VerificationTest, AWellDeterminedPoseHasNoLeaveOneOutRival) {
     ++tested;
   }
   EXPECT_GE(tested, kScenes / 3);
+}
+
+TEST_F(VerificationTest, ConsensusMemoGivesTheSameTrimmedHypothesis) {
+  int restarted = 0;
+  for (const SyntheticScene& scene : Scenes(24, false)) {
+    VerificationContext context = Context(scene);
+    // True pairs plus two lines given to the edges of other pairs: the restart's consensus runs.
+    std::vector<std::pair<int, int>> pairs = scene.matches;
+    for (size_t k = 0; k + 1 < scene.matches.size() && k < 2; ++k) {
+      if (scene.matches[k].first != scene.matches[k + 1].first)
+        pairs.emplace_back(scene.matches[k + 1].first, scene.matches[k].second);
+    }
+    const VerifiedPose start = RefineHypothesis(context, pairs, {scene.truth.Planar()}, options_);
+    if (!ConsistentHypothesis(start, options_)) ++restarted;
+    VerifiedPose plain = start;
+    const bool plain_ok = TrimHypothesis(context, options_, &plain);
+    ConsensusMemo memo;
+    context.consensus_memo = &memo;
+    for (int pass = 0; pass < 2; ++pass) {  // the memo filled, then read
+      VerifiedPose memoised = start;
+      EXPECT_EQ(TrimHypothesis(context, options_, &memoised), plain_ok) << "scene " << scene.index;
+      EXPECT_EQ(memoised.pairs, plain.pairs) << "scene " << scene.index;
+      EXPECT_EQ(memoised.pose.x, plain.pose.x) << "scene " << scene.index;
+      EXPECT_EQ(memoised.pose.y, plain.pose.y) << "scene " << scene.index;
+      EXPECT_EQ(memoised.pose.heading, plain.pose.heading) << "scene " << scene.index;
+    }
+    if (!ConsistentHypothesis(start, options_)) {
+      EXPECT_FALSE(memo.entries.empty()) << "scene " << scene.index;
+    }
+  }
+  EXPECT_GE(restarted, kScenes / 2);
 }
 
 }  // namespace
