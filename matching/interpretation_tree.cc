@@ -8,6 +8,15 @@
 #include <set>
 
 namespace linetrack {
+
+bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
+                          const std::vector<std::pair<int, int>>& fitting) {
+  return std::any_of(pairs.begin(), pairs.end(), [&](const std::pair<int, int>& p) {
+    if (std::binary_search(fitting.begin(), fitting.end(), p)) return false;
+    return std::any_of(fitting.begin(), fitting.end(),
+                       [&](const std::pair<int, int>& f) { return f.second == p.second; });
+  });
+}
 namespace {
 
 // The tree is searched line by line (the data-driven order of Grimson's interpretation tree):
@@ -302,10 +311,14 @@ class TreeSearch {
 
   void VisitLeaf(const std::vector<char>& alive, const FeasibleRegion& region) {
     if (!IsMaximal(alive, region)) return;
-    // A leaf consistent with a verified pose would be verified into it again.
+    // A leaf consistent with a verified pose would be verified into it again: its region holds
+    // the pose and it assigns no line otherwise than the pose does (a line fitting the pose with
+    // another edge). A leaf giving a line to another edge is another interpretation, however wide
+    // its region (3-sigma gates) is: verified (docs/matching.md, section 6, fourth round).
     if (basins_ != nullptr &&
-        std::any_of(basins_->begin(), basins_->end(),
-                    [&](const VerifiedBasin& b) { return region.Contains(b.pose); })) {
+        std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
+          return !AssignsLineOtherwise(assigned_, b.fitting) && region.Contains(b.pose);
+        })) {
       return;
     }
     Hypothesis leaf{assigned_, region, assigned_caps_};

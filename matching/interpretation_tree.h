@@ -83,6 +83,12 @@ struct VerifiedBasin {
   std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
 };
 
+// True when `pairs` (edge index, line index) give a line to another edge than a verified pose
+// does: a pair not in the pose's `fitting` pairs (sorted) whose line is in one of them. Such a
+// leaf is another interpretation, not the verified pose again, even when its region holds it.
+bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
+                          const std::vector<std::pair<int, int>>& fitting);
+
 struct InterpretationTreeStats {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int nodes = 0;             // tree nodes expanded

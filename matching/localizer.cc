@@ -298,6 +298,19 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     result.reason = "ambiguous: another pose explains the image almost as well";
     return;
   }
+  // An unobservable pose inside the prior is a rival explanation too: when a distinct one comes
+  // within the margin, the accepted pose is not clearly the best explanation of the lines.
+  for (VerifiedPose& v : verified) {
+    if (!v.unobservable || v.evidence.lines_nats < score - vo.ambiguity_nats ||
+        SamePose(v.pose, best.pose, vo)) {
+      continue;  // the edges term is not positive: lines_nats bounds the evidence
+    }
+    CompleteEvidence(context, vo, &v);
+    if (v.evidence.Score() > score - vo.ambiguity_nats) {
+      result.reason = "ambiguous: an unobservable pose explains the image almost as well";
+      return;
+    }
+  }
   const double required = RequiredEvidence(context, vo, best);
   if (score < required) {
     result.reason =

@@ -294,6 +294,10 @@ void Judge(const VerificationContext& context, const VerificationOptions& option
     result->implausible_because = "focal scale";
   }
   result->plausible = result->implausible_because.empty();
+  result->unobservable =
+      result->implausible_because == "unobservable" &&
+      !(options.refinement.focal_prior_sigma > 0.0 &&
+        std::abs(r.focal_scale - 1.0) > 4.0 * options.refinement.focal_prior_sigma);
 }
 
 }  // namespace
