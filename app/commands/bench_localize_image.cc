@@ -14,6 +14,7 @@
 
 #include "app/commands.h"
 #include "app/localize_image.h"
+#include "app/match_outcome.h"
 #include "app/rendered_cases.h"
 #include "matching/lines/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -24,9 +25,6 @@
 namespace linetrack::app {
 namespace {
 
-// As `bench match`: a wrong correspondence set whose pose is this close is "wrong but accurate".
-constexpr double kAccuratePositionM = 0.5;
-constexpr double kAccurateHeadingDeg = 5.0;
 // The paper's accuracy on real images (Table 4): pose within these of the truth.
 constexpr double kPaperPositionM = 0.2;
 constexpr double kPaperHeadingDeg = 3.0;
@@ -51,8 +49,7 @@ struct BenchLocalizeImageOptions {
   std::string out_path;
 };
 
-enum class Outcome { kCorrect, kNone, kWrongAccurate, kWrong };
-const char* const kOutcomeNames[] = {"correct", "no answer", "wrong but accurate", "wrong"};
+using Outcome = MatchOutcome;
 
 // Why an image was not localised correctly: the matcher fails on the exact projections too;
 // it succeeds on those but not on the detections that image model edges (the detector did not
@@ -65,22 +62,19 @@ const char* const kCauseNames[] = {"matcher (fails on the exact lines too)",
                                    "unmodelled lines (matcher correct on the detected model "
                                    "lines alone)"};
 
-// Judged as `bench match` judges: every reported correspondence is a true one (the line lies
-// along the edge's projection at the true pose), else by the pose error.
+// Judged as `bench match` judges (JudgeMatch); a reported correspondence is true when the line
+// lies along the edge's projection at the true pose.
 Outcome Judge(const RenderedCase& c, const LocalizationResult& result,
               const std::vector<std::vector<int>>& true_edges_of_line) {
-  if (!result.found) return Outcome::kNone;
   const bool all_true =
       !result.matches.empty() &&
       std::all_of(result.matches.begin(), result.matches.end(), [&](const auto& m) {
         const std::vector<int>& ids = true_edges_of_line[m.second];
         return std::find(ids.begin(), ids.end(), m.first) != ids.end();
       });
-  if (all_true) return Outcome::kCorrect;
   const double dp = std::hypot(result.pose.x - c.scene.truth.x, result.pose.y - c.scene.truth.y);
   const double dh = RadToDeg(std::abs(WrapAngle(result.pose.heading - c.scene.truth.heading)));
-  return dp <= kAccuratePositionM && dh <= kAccurateHeadingDeg ? Outcome::kWrongAccurate
-                                                               : Outcome::kWrong;
+  return JudgeMatch(result.found, all_true, dp, dh);
 }
 
 double Quantile(std::vector<double> v, double q) {
@@ -195,10 +189,9 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
     const FailureCause cause = Attribute(c, lines, localizer);
     ++causes[static_cast<int>(cause)];
     const DetectionEvaluation found = EvaluateDetections(c.observable, lines, kMinEdgeLengthPx, {});
-    failures << "| " << i << " | " << kOutcomeNames[static_cast<int>(outcome)] << " | "
-             << found.found << " / " << found.edges.size() << " | "
-             << kCauseNames[static_cast<int>(cause)] << " | " << (result.found ? "" : result.reason)
-             << " |\n";
+    failures << "| " << i << " | " << MatchOutcomeName(outcome) << " | " << found.found << " / "
+             << found.edges.size() << " | " << kCauseNames[static_cast<int>(cause)] << " | "
+             << (result.found ? "" : result.reason) << " |\n";
     if ((i + 1) % 50 == 0) spdlog::info("{}/{} images", i + 1, cases.size());
   }
 

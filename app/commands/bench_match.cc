@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/match_outcome.h"
 #include "matching/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
@@ -21,11 +22,6 @@
 
 namespace linetrack::app {
 namespace {
-
-// A wrong correspondence set whose pose is still this close counts as "wrong but accurate"
-// (the paper's consistent false positive); farther is "wrong".
-constexpr double kAccuratePositionM = 0.5;
-constexpr double kAccurateHeadingDeg = 5.0;
 
 struct Series {
   std::string name;
@@ -73,32 +69,16 @@ double Percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
-enum class Outcome { kCorrect, kNone, kWrongAccurate, kWrong };
-
-const char* OutcomeName(Outcome o) {
-  switch (o) {
-    case Outcome::kCorrect:
-      return "correct";
-    case Outcome::kNone:
-      return "no answer";
-    case Outcome::kWrongAccurate:
-      return "wrong but accurate";
-    case Outcome::kWrong:
-      return "wrong";
-  }
-  return "";
-}
+using Outcome = MatchOutcome;
 
 Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result) {
-  if (!result.found) return Outcome::kNone;
   const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
-  const bool all_true = std::all_of(result.matches.begin(), result.matches.end(),
-                                    [&](const auto& m) { return truth.count(m) > 0; });
+  const bool all_true =
+      !result.matches.empty() && std::all_of(result.matches.begin(), result.matches.end(),
+                                             [&](const auto& m) { return truth.count(m) > 0; });
   const double dp = std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y);
   const double dh = RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)));
-  if (all_true && !result.matches.empty()) return Outcome::kCorrect;
-  if (dp <= kAccuratePositionM && dh <= kAccurateHeadingDeg) return Outcome::kWrongAccurate;
-  return Outcome::kWrong;
+  return JudgeMatch(result.found, all_true, dp, dh);
 }
 
 Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, double ms,
@@ -166,7 +146,7 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
         {f.pose.x, f.pose.y, RadToDeg(f.pose.heading), f.evidence.Score(), f.matched_edges});
   }
   return {{"scene", scene.index},
-          {"outcome", OutcomeName(outcome)},
+          {"outcome", MatchOutcomeName(outcome)},
           {"category", category},
           {"reason", result.reason},
           {"hypotheses", result.hypotheses},
