@@ -281,23 +281,20 @@ void Judge(const VerificationContext& context, const VerificationOptions& option
           ? std::numeric_limits<double>::infinity()
           : PartialHausdorff(distances, std::min<int>(options.min_matches, distances.size()));
   const PoseRefinementResult& r = result->refinement;
-  result->implausible_because.clear();
-  if (result->matched_edges < options.min_matches) {
-    result->implausible_because = "too few edges";
-  } else if (!InsidePrior(context, result->pose, r, options)) {
-    result->implausible_because = "outside the prior";
-  } else if (r.position_sigma_m > options.max_position_sigma_m ||
-             r.heading_sigma_rad > DegToRad(options.max_heading_sigma_deg)) {
-    result->implausible_because = "unobservable";
-  } else if (options.refinement.focal_prior_sigma > 0.0 &&
-             std::abs(r.focal_scale - 1.0) > 4.0 * options.refinement.focal_prior_sigma) {
-    result->implausible_because = "focal scale";
-  }
-  result->plausible = result->implausible_because.empty();
-  result->unobservable =
-      result->implausible_because == "unobservable" &&
+  const bool enough_edges = result->matched_edges >= options.min_matches;
+  const bool inside = enough_edges && InsidePrior(context, result->pose, r, options);
+  const bool observable = !(r.position_sigma_m > options.max_position_sigma_m ||
+                            r.heading_sigma_rad > DegToRad(options.max_heading_sigma_deg));
+  const bool focal_ok =
       !(options.refinement.focal_prior_sigma > 0.0 &&
         std::abs(r.focal_scale - 1.0) > 4.0 * options.refinement.focal_prior_sigma);
+  result->implausible_because = !enough_edges ? "too few edges"
+                                : !inside     ? "outside the prior"
+                                : !observable ? "unobservable"
+                                : !focal_ok   ? "focal scale"
+                                              : "";
+  result->plausible = result->implausible_because.empty();
+  result->unobservable = inside && !observable && focal_ok;
 }
 
 }  // namespace

@@ -105,6 +105,16 @@ class RivalLinesTest : public ::testing::Test {
                    options_);
   }
 
+  // The pairs reported when line `line`, shifted by `offset_px`, is added to the scene's lines
+  // (its index is scene.lines.size()).
+  std::vector<std::pair<int, int>> ReportedWithTwin(const SyntheticScene& scene, int line,
+                                                    double offset_px) {
+    std::vector<Segment2> lines = scene.lines;
+    lines.push_back(Shifted(lines[line], offset_px));
+    const VerificationContext context = Context(scene, lines);
+    return PairsBeatingRivalLines(context, options_, Verified(context, scene, scene.matches));
+  }
+
   WireframeModel model_;
   NavigableArea area_;
   CameraIntrinsics camera_;
@@ -123,28 +133,16 @@ TEST_F(RivalLinesTest, AParallelLineWithinTheNoiseContestsTheEdgeBeyondTheGateIt
     const int twin = static_cast<int>(scene.lines.size());
     // A parallel line over the same stretch within the noise: neither line is the edge's image
     // with odds of e^report_nats; the other pairs are still reported.
-    {
-      std::vector<Segment2> lines = scene.lines;
-      lines.push_back(Shifted(lines[line], kWithinNoisePx));
-      const VerificationContext context = Context(scene, lines);
-      const VerifiedPose v = Verified(context, scene, scene.matches);
-      const std::vector<std::pair<int, int>> reported =
-          PairsBeatingRivalLines(context, options_, v);
-      EXPECT_FALSE(Has(reported, {edge, line})) << "scene " << scene.index;
-      EXPECT_FALSE(Has(reported, {edge, twin})) << "scene " << scene.index;
-      EXPECT_FALSE(reported.empty()) << "scene " << scene.index;
-    }
+    const std::vector<std::pair<int, int>> contested =
+        ReportedWithTwin(scene, line, kWithinNoisePx);
+    EXPECT_FALSE(Has(contested, {edge, line})) << "scene " << scene.index;
+    EXPECT_FALSE(Has(contested, {edge, twin})) << "scene " << scene.index;
+    EXPECT_FALSE(contested.empty()) << "scene " << scene.index;
     // The same line far beyond the noise is no rival.
-    {
-      std::vector<Segment2> lines = scene.lines;
-      lines.push_back(Shifted(lines[line], kBeyondGatePx));
-      const VerificationContext context = Context(scene, lines);
-      const VerifiedPose v = Verified(context, scene, scene.matches);
-      const std::vector<std::pair<int, int>> reported =
-          PairsBeatingRivalLines(context, options_, v);
-      EXPECT_TRUE(Has(reported, {edge, line})) << "scene " << scene.index;
-      EXPECT_FALSE(Has(reported, {edge, twin})) << "scene " << scene.index;
-    }
+    const std::vector<std::pair<int, int>> uncontested =
+        ReportedWithTwin(scene, line, kBeyondGatePx);
+    EXPECT_TRUE(Has(uncontested, {edge, line})) << "scene " << scene.index;
+    EXPECT_FALSE(Has(uncontested, {edge, twin})) << "scene " << scene.index;
     ++tested;
   }
   EXPECT_GE(tested, kScenes / 2);
