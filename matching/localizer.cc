@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 
@@ -80,6 +83,48 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
   return regions_->Query(query);
 }
 
+namespace {
+
+// A trimmed hypothesis already verified: its index in the verified poses, the guided-matching
+// pair tests it cost, and its basin (index, -1 when implausible or not yet added).
+struct RematchedLeaf {
+  size_t verified = 0;
+  long pair_tests = 0;
+  long basin = -1;
+};
+
+// Everything guided matching reads from a trimmed hypothesis (pairs in order, pose, focal scale
+// and covariance), bit for bit: equal keys give identical verified poses.
+std::vector<uint64_t> TrimmedHypothesisKey(const VerifiedPose& leaf) {
+  std::vector<uint64_t> key;
+  for (const auto& [e, l] : leaf.pairs)
+    key.push_back((static_cast<uint64_t>(static_cast<uint32_t>(e)) << 32) |
+                  static_cast<uint32_t>(l));
+  auto add = [&](double value) {
+    uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    key.push_back(bits);
+  };
+  add(leaf.pose.x);
+  add(leaf.pose.y);
+  add(leaf.pose.heading);
+  const PoseRefinementResult& r = leaf.refinement;
+  add(r.focal_scale);
+  add(r.chi2);
+  add(r.rms_px);
+  add(r.pose.x);
+  add(r.pose.y);
+  add(r.pose.heading);
+  key.push_back(static_cast<uint64_t>(r.iterations) * 2 + (r.converged ? 1 : 0));
+  add(r.position_sigma_m);
+  add(r.heading_sigma_rad);
+  for (int i = 0; i < r.covariance.size(); ++i)
+    add(r.covariance.data()[i]);
+  return key;
+}
+
+}  // namespace
+
 LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
   CheckProblem(problem);
   LocalizationResult result;
@@ -124,6 +169,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     context.pair_tests = &pair_tests;
     ConsensusMemo consensus_memo;
     context.consensus_memo = &consensus_memo;
+    std::map<std::vector<uint64_t>, RematchedLeaf> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -154,17 +200,35 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
         return bound;
       }
-      VerifiedPose v = Rematch(context, leaf, vo);
+      // Sibling leaves often trim to the very same hypothesis (the consensus restart keeps the
+      // same agreeing pairs): guided matching from it would give the same pose again, so it is
+      // replayed, with its share of the work budget.
+      std::vector<uint64_t> key = TrimmedHypothesisKey(leaf);
+      const auto [known, fresh] = rematched.try_emplace(std::move(key), RematchedLeaf{});
+      VerifiedPose v;
+      if (fresh) {
+        const long tests_before = pair_tests;
+        v = Rematch(context, leaf, vo);
+        known->second = {verified.size(), pair_tests - tests_before, -1};
+      } else {
+        v = verified[known->second.verified];
+        pair_tests += known->second.pair_tests;
+      }
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
         best = std::max(best, v.evidence.Score());
         // Leaves that would be verified into this pose again are not verified: those whose
         // region holds it or lies within basin_sigmas of its standard deviations, and those
         // most of whose pairs fit it.
-        basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
-                          vo.basin_sigmas * v.refinement.heading_sigma_rad,
-                          static_cast<int>(v.pairs.size()), v.evidence.Score(),
-                          FittingPairs(context, vo, v)});
+        if (known->second.basin < 0) {
+          known->second.basin = static_cast<long>(basins.size());
+          basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
+                            vo.basin_sigmas * v.refinement.heading_sigma_rad,
+                            static_cast<int>(v.pairs.size()), v.evidence.Score(),
+                            FittingPairs(context, vo, v)});
+        } else {
+          basins.push_back(basins[known->second.basin]);
+        }
       }
       std::vector<std::pair<int, int>> pairs = v.pairs;
       std::sort(pairs.begin(), pairs.end());
