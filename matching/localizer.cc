@@ -85,14 +85,6 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
 
 namespace {
 
-// A trimmed hypothesis already verified: its index in the verified poses, the guided-matching
-// pair tests it cost, and its basin (index, -1 when implausible or not yet added).
-struct RematchedLeaf {
-  size_t verified = 0;
-  long pair_tests = 0;
-  long basin = -1;
-};
-
 // Everything guided matching reads from a trimmed hypothesis (pairs in order, pose, focal scale
 // and covariance), bit for bit: equal keys give identical verified poses.
 std::vector<uint64_t> TrimmedHypothesisKey(const VerifiedPose& leaf) {
@@ -169,7 +161,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     context.pair_tests = &pair_tests;
     ConsensusMemo consensus_memo;
     context.consensus_memo = &consensus_memo;
-    std::map<std::vector<uint64_t>, RematchedLeaf> rematched;
+    // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
+    std::map<std::vector<uint64_t>, long> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -201,34 +194,27 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
         return bound;
       }
       // Sibling leaves often trim to the very same hypothesis (the consensus restart keeps the
-      // same agreeing pairs): guided matching from it would give the same pose again, so it is
-      // replayed, with its share of the work budget.
-      std::vector<uint64_t> key = TrimmedHypothesisKey(leaf);
-      const auto [known, fresh] = rematched.try_emplace(std::move(key), RematchedLeaf{});
-      VerifiedPose v;
-      if (fresh) {
-        const long tests_before = pair_tests;
-        v = Rematch(context, leaf, vo);
-        known->second = {verified.size(), pair_tests - tests_before, -1};
-      } else {
-        v = verified[known->second.verified];
-        pair_tests += known->second.pair_tests;
+      // same agreeing pairs): guided matching from it would give the same pose again, which the
+      // verified poses, basins and best evidence already hold (duplicates change no rule nor
+      // decision). Its share of the work budget still counts.
+      const auto [known, fresh] = rematched.try_emplace(TrimmedHypothesisKey(leaf), 0L);
+      if (!fresh) {
+        pair_tests += known->second;
+        return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       }
+      const long tests_before = pair_tests;
+      VerifiedPose v = Rematch(context, leaf, vo);
+      known->second = pair_tests - tests_before;
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
         best = std::max(best, v.evidence.Score());
         // Leaves that would be verified into this pose again are not verified: those whose
         // region holds it or lies within basin_sigmas of its standard deviations, and those
         // most of whose pairs fit it.
-        if (known->second.basin < 0) {
-          known->second.basin = static_cast<long>(basins.size());
-          basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
-                            vo.basin_sigmas * v.refinement.heading_sigma_rad,
-                            static_cast<int>(v.pairs.size()), v.evidence.Score(),
-                            FittingPairs(context, vo, v)});
-        } else {
-          basins.push_back(basins[known->second.basin]);
-        }
+        basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
+                          vo.basin_sigmas * v.refinement.heading_sigma_rad,
+                          static_cast<int>(v.pairs.size()), v.evidence.Score(),
+                          FittingPairs(context, vo, v)});
       }
       std::vector<std::pair<int, int>> pairs = v.pairs;
       std::sort(pairs.begin(), pairs.end());
