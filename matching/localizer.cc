@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -85,34 +83,29 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
 
 namespace {
 
-// Everything guided matching reads from a trimmed hypothesis (pairs in order, pose, focal scale
-// and covariance), bit for bit: equal keys give identical verified poses.
-std::vector<uint64_t> TrimmedHypothesisKey(const VerifiedPose& leaf) {
-  std::vector<uint64_t> key;
-  for (const auto& [e, l] : leaf.pairs)
-    key.push_back((static_cast<uint64_t>(static_cast<uint32_t>(e)) << 32) |
-                  static_cast<uint32_t>(l));
-  auto add = [&](double value) {
-    uint64_t bits;
-    std::memcpy(&bits, &value, sizeof bits);
-    key.push_back(bits);
-  };
-  add(leaf.pose.x);
-  add(leaf.pose.y);
-  add(leaf.pose.heading);
-  const PoseRefinementResult& r = leaf.refinement;
-  add(r.focal_scale);
-  add(r.chi2);
-  add(r.rms_px);
-  add(r.pose.x);
-  add(r.pose.y);
-  add(r.pose.heading);
-  key.push_back(static_cast<uint64_t>(r.iterations) * 2 + (r.converged ? 1 : 0));
-  add(r.position_sigma_m);
-  add(r.heading_sigma_rad);
-  for (int i = 0; i < r.covariance.size(); ++i)
-    add(r.covariance.data()[i]);
-  return key;
+// A trimmed hypothesis already verified: its pose and focal scale, and the guided-matching pair
+// tests its verification cost.
+struct RematchedHypothesis {
+  Pose3Dof pose;
+  double focal_scale = 1.0;
+  long pair_tests = 0;
+};
+
+// True when the trimmed hypothesis `leaf` is one already verified: the same pairs at the same
+// pose and focal scale, to within a hundred times the Levenberg-Marquardt step tolerance (1 cm,
+// 0.1 degree, 0.1 % of focal length; the poses' noise is about 7 cm and 0.3 degree). Guided
+// matching from it would give the same pose again.
+bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypothesis>& known,
+                     long* pair_tests) {
+  for (const RematchedHypothesis& k : known) {
+    if (std::abs(k.pose.x - leaf.pose.x) <= 0.01 && std::abs(k.pose.y - leaf.pose.y) <= 0.01 &&
+        std::abs(WrapAngle(k.pose.heading - leaf.pose.heading)) <= DegToRad(0.1) &&
+        std::abs(k.focal_scale - leaf.refinement.focal_scale) <= 1e-3) {
+      *pair_tests += k.pair_tests;
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -162,7 +155,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     ConsensusMemo consensus_memo;
     context.consensus_memo = &consensus_memo;
     // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
-    std::map<std::vector<uint64_t>, long> rematched;
+    std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -193,18 +186,19 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
         return bound;
       }
-      // Sibling leaves often trim to the very same hypothesis (the consensus restart keeps the
-      // same agreeing pairs): guided matching from it would give the same pose again, which the
-      // verified poses, basins and best evidence already hold (duplicates change no rule nor
-      // decision). Its share of the work budget still counts.
-      const auto [known, fresh] = rematched.try_emplace(TrimmedHypothesisKey(leaf), 0L);
-      if (!fresh) {
-        pair_tests += known->second;
+      // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
+      // agreeing pairs): guided matching from it would give the same pose again, which the
+      // verified poses, basins and best evidence already hold. Its share of the work budget still
+      // counts.
+      std::vector<std::pair<int, int>> trimmed = leaf.pairs;
+      std::sort(trimmed.begin(), trimmed.end());
+      std::vector<RematchedHypothesis>& known = rematched[std::move(trimmed)];
+      if (AlreadyVerified(leaf, known, &pair_tests)) {
         return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       }
       const long tests_before = pair_tests;
       VerifiedPose v = Rematch(context, leaf, vo);
-      known->second = pair_tests - tests_before;
+      known.push_back({leaf.pose, leaf.refinement.focal_scale, pair_tests - tests_before});
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
         best = std::max(best, v.evidence.Score());
