@@ -91,16 +91,12 @@ struct RematchedHypothesis {
   long pair_tests = 0;
 };
 
-// True when the trimmed hypothesis `leaf` is one already verified: the same pairs at the same
-// pose and focal scale, to within a hundred times the Levenberg-Marquardt step tolerance (1 cm,
-// 0.1 degree, 0.1 % of focal length; the poses' noise is about 7 cm and 0.3 degree). Guided
-// matching from it would give the same pose again.
+// True when the trimmed hypothesis `leaf` (pairs as those of `known`) is one already verified
+// (SameRefinedPose); then adds the pair tests its verification cost to `pair_tests`.
 bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypothesis>& known,
                      long* pair_tests) {
   for (const RematchedHypothesis& k : known) {
-    if (std::abs(k.pose.x - leaf.pose.x) <= 0.01 && std::abs(k.pose.y - leaf.pose.y) <= 0.01 &&
-        std::abs(WrapAngle(k.pose.heading - leaf.pose.heading)) <= DegToRad(0.1) &&
-        std::abs(k.focal_scale - leaf.refinement.focal_scale) <= 1e-3) {
+    if (SameRefinedPose(k.pose, k.focal_scale, leaf.pose, leaf.refinement.focal_scale)) {
       *pair_tests += k.pair_tests;
       return true;
     }
