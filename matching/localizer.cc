@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 
@@ -80,6 +81,31 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
   return regions_->Query(query);
 }
 
+namespace {
+
+// A trimmed hypothesis already verified: its pose and focal scale, and the guided-matching pair
+// tests its verification cost.
+struct RematchedHypothesis {
+  Pose3Dof pose;
+  double focal_scale = 1.0;
+  long pair_tests = 0;
+};
+
+// True when the trimmed hypothesis `leaf` (pairs as those of `known`) is one already verified
+// (SameRefinedPose); then adds the pair tests its verification cost to `pair_tests`.
+bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypothesis>& known,
+                     long* pair_tests) {
+  for (const RematchedHypothesis& k : known) {
+    if (SameRefinedPose(k.pose, k.focal_scale, leaf.pose, leaf.refinement.focal_scale)) {
+      *pair_tests += k.pair_tests;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
   CheckProblem(problem);
   LocalizationResult result;
@@ -124,6 +150,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     context.pair_tests = &pair_tests;
     ConsensusMemo consensus_memo;
     context.consensus_memo = &consensus_memo;
+    // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
+    std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -154,7 +182,19 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
         return bound;
       }
+      // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
+      // agreeing pairs): guided matching from it would give the same pose again, which the
+      // verified poses, basins and best evidence already hold. Its share of the work budget still
+      // counts.
+      std::vector<std::pair<int, int>> trimmed = leaf.pairs;
+      std::sort(trimmed.begin(), trimmed.end());
+      std::vector<RematchedHypothesis>& known = rematched[std::move(trimmed)];
+      if (AlreadyVerified(leaf, known, &pair_tests)) {
+        return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
+      }
+      const long tests_before = pair_tests;
       VerifiedPose v = Rematch(context, leaf, vo);
+      known.push_back({leaf.pose, leaf.refinement.focal_scale, pair_tests - tests_before});
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
         best = std::max(best, v.evidence.Score());

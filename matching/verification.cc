@@ -599,4 +599,10 @@ bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& o
          std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(options.same_pose_deg);
 }
 
+bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b) {
+  return std::abs(a.x - b.x) <= 0.01 && std::abs(a.y - b.y) <= 0.01 &&
+         std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(0.1) &&
+         std::abs(scale_a - scale_b) <= 1e-3;
+}
+
 }  // namespace linetrack

@@ -261,4 +261,10 @@ bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
 // True when two poses are the same answer (within same_pose_m and same_pose_deg).
 bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options);
 
+// True when two refined hypotheses of the same pairs are one pose: positions within 1 cm,
+// headings within 0.1 degree and focal scales within 0.1 % (a hundred times the verification's
+// Levenberg-Marquardt step tolerance, far below the poses' noise of about 7 cm and 0.3 degree).
+// Guided matching from either gives the same verified pose (the localizer verifies it once).
+bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b);
+
 }  // namespace linetrack
