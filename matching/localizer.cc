@@ -370,9 +370,15 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.found = true;
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
-  result.covariance = best.refinement.covariance.topLeftCorner<3, 3>();
-  result.position_sigma_m = best.refinement.position_sigma_m;
-  result.heading_sigma_rad = best.refinement.heading_sigma_rad;
+  // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
+  // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
+  const PoseRefinementResult vouched = VouchedRefinement(context, vo, best, reported);
+  const bool observable = vouched.position_sigma_m <= vo.max_position_sigma_m &&
+                          vouched.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
+  const PoseRefinementResult& uncertainty = observable ? vouched : best.refinement;
+  result.covariance = uncertainty.covariance.topLeftCorner<3, 3>();
+  result.position_sigma_m = uncertainty.position_sigma_m;
+  result.heading_sigma_rad = uncertainty.heading_sigma_rad;
   for (const auto& [e, l] : reported)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());

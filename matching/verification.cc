@@ -349,8 +349,11 @@ LineFitModel FitModel(const VerificationContext& context, const VerificationOpti
 bool VerificationOptions::Check(std::string* why) const {
   if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
       max_pair_tests < 1 || !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
-      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
-    *why = "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1)";
+      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0) ||
+      !(max_unreported_leverage > 0.0 && max_unreported_leverage <= 1.0)) {
+    *why =
+        "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1), "
+        "max_unreported_leverage in (0, 1]";
     return false;
   }
   return refinement.Check(why);
