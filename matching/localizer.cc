@@ -106,15 +106,7 @@ bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypoth
 
 }  // namespace
 
-LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
-  CheckProblem(problem);
-  LocalizationResult result;
-  const std::vector<int> ids = CandidateEdges(problem);
-  result.candidate_edges = static_cast<int>(ids.size());
-  const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
-  const std::vector<ObservedLine> lines = PrepareLines(
-      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
-
+PriorRegion Localizer::Prior(const LocalizationProblem& problem) const {
   PriorRegion prior;
   prior.centre = {problem.prior.x, problem.prior.y};
   prior.radius = problem.delta_t;
@@ -127,6 +119,19 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     prior.bounds_min = area_->BoundsMin();
     prior.bounds_max = area_->BoundsMax();
   }
+  return prior;
+}
+
+LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
+  CheckProblem(problem);
+  LocalizationResult result;
+  const std::vector<int> ids = CandidateEdges(problem);
+  result.candidate_edges = static_cast<int>(ids.size());
+  const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
+  const std::vector<ObservedLine> lines = PrepareLines(
+      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
+
+  const PriorRegion prior = Prior(problem);
   VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
                               &occlusion_, &prior, area_,    options_.noise};
   std::vector<VerifiedPose> verified;
@@ -216,6 +221,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
     result.tree_checks = stats.checks;
+    result.tree_completed_bound = stats.completed_bound;
     result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
     if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
       SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
@@ -286,6 +292,8 @@ void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
         &stats, nullptr);
     result->tree_nodes += stats.nodes;
     result->tree_checks += stats.checks;
+    result->unexplained_completed_bound =
+        std::max(result->unexplained_completed_bound, stats.completed_bound);
   }
 }
 

@@ -161,6 +161,8 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
           {"budget_exhausted", result.budget_exhausted},
           {"tree_nodes", result.tree_nodes},
           {"tree_checks", result.tree_checks},
+          {"tree_completed_bound", result.tree_completed_bound},
+          {"unexplained_completed_bound", result.unexplained_completed_bound},
           {"pose_error",
            {std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y),
             RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)))}},
@@ -185,6 +187,22 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
           {"truth_pose", {scene.truth.x, scene.truth.y, RadToDeg(scene.truth.heading)}},
           {"finalists", finalists},
           {"pairs", pairs}};
+}
+
+// A correct answer whose search budget ran out: its evidence against the bound of the tree's
+// last completed pass (the leaves it did not visit lie below it).
+nlohmann::ordered_json BudgetJson(const SyntheticScene& scene, const LocalizationResult& result,
+                                  const std::string& series) {
+  return {{"scene", scene.index},
+          {"outcome", MatchOutcomeName(MatchOutcome::kCorrect)},
+          {"budget_exhausted", true},
+          {"tree_nodes", result.tree_nodes},
+          {"tree_checks", result.tree_checks},
+          {"tree_completed_bound", result.tree_completed_bound},
+          {"unexplained_completed_bound", result.unexplained_completed_bound},
+          {"chosen_evidence",
+           result.finalists.empty() ? 0.0 : result.finalists.front().evidence.Score()},
+          {"series", series}};
 }
 
 std::string Row(const std::string& matcher, const Tally& t) {
@@ -264,6 +282,9 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
           nlohmann::ordered_json j = DiagnosisJson(scene, result, outcome, d, category);
           j["series"] = s.name;
           *diagnosis << j.dump() << "\n";
+        } else if (m == 0 && diagnosis && result.budget_exhausted) {
+          // Correct answers after an exhausted search: what the budget left unexplored.
+          *diagnosis << BudgetJson(scene, result, s.name).dump() << "\n";
         }
       }
       if ((i + 1) % 50 == 0) spdlog::info("{}: {}/{} scenes", s.name, i + 1, scenes.size());
@@ -318,7 +339,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->add_option("--diagnose", opt->diagnose_path,
                   "Write a JSON line per scene the tree does not answer correctly: where the "
-                  "true correspondences are lost (matching/diagnosis.h)");
+                  "true correspondences are lost (matching/diagnosis.h); and a short one per "
+                  "correct answer whose search budget ran out");
   cmd->add_option("--only", opt->only,
                   "Run only these scene indices (0-based, of the --count generated; debugging)")
       ->delimiter(',');
