@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "matching/pose_refinement.h"
+#include "matching/quantiles.h"
 #include "matching/verification.h"
 
 namespace linetrack {
@@ -14,13 +15,5 @@ namespace linetrack {
 // (the projection is not known yet).
 std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
                                      const std::vector<std::pair<int, int>>& pairs);
-
-// Wilson-Hilferty approximation of the chi-square quantile with `dof` degrees of freedom at
-// standard normal quantile z.
-double ChiSquareQuantile(double dof, double z);
-
-// Standard normal quantile for p in (0.975, 1) (Acklam's rational approximation, upper tail;
-// relative error below 1.2e-9).
-double NormalQuantile(double p);
 
 }  // namespace linetrack

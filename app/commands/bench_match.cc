@@ -72,20 +72,26 @@ double Percentile(std::vector<double> v, double q) {
 
 using Outcome = MatchOutcome;
 
-Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result) {
+// How far the answer is from the truth (app/match_outcome.h).
+PoseErrors AnswerErrors(const SyntheticScene& scene, const LocalizationResult& result) {
+  return ErrorsOf(result.pose.Planar(), result.covariance, scene.truth.Planar());
+}
+
+Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result,
+              const PoseErrors& errors) {
   const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
   const bool all_true =
       !result.matches.empty() && std::all_of(result.matches.begin(), result.matches.end(),
                                              [&](const auto& m) { return truth.count(m) > 0; });
-  return JudgeMatch(result.found, all_true,
-                    ErrorsOf(result.pose.Planar(), result.covariance, scene.truth.Planar()));
+  return JudgeMatch(result.found, all_true, errors);
 }
 
 Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, double ms,
               Tally* tally) {
   tally->hypotheses.push_back(result.hypotheses);
   tally->times_ms.push_back(ms);
-  const Outcome outcome = Judge(scene, result);
+  const PoseErrors errors = AnswerErrors(scene, result);
+  const Outcome outcome = Judge(scene, result, errors);
   switch (outcome) {
     case Outcome::kNone:
       ++tally->none;
@@ -98,13 +104,9 @@ Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, dou
       break;
     case Outcome::kCorrect:
       ++tally->correct;
-      if (!ErrorsOf(result.pose.Planar(), result.covariance, scene.truth.Planar())
-               .WithinTolerance())
-        ++tally->correct_beyond_tolerance;
-      tally->position_error_m.push_back(
-          std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y));
-      tally->heading_error_deg.push_back(
-          RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading))));
+      if (!errors.WithinTolerance()) ++tally->correct_beyond_tolerance;
+      tally->position_error_m.push_back(errors.position_m);
+      tally->heading_error_deg.push_back(errors.heading_deg);
       break;
   }
   return outcome;
@@ -148,6 +150,7 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
     for (const auto& m : result.finalists.front().matches)
       pose_false_pairs += truth.count(m) ? 0 : 1;
   }
+  const PoseErrors errors = AnswerErrors(scene, result);
   nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
   for (const Finalist& f : result.finalists) {
     finalists.push_back(
@@ -163,13 +166,10 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
           {"tree_checks", result.tree_checks},
           {"tree_completed_bound", result.tree_completed_bound},
           {"unexplained_completed_bound", result.unexplained_completed_bound},
-          {"pose_error",
-           {std::hypot(result.pose.x - scene.truth.x, result.pose.y - scene.truth.y),
-            RadToDeg(std::abs(WrapAngle(result.pose.heading - scene.truth.heading)))}},
+          {"pose_error", {errors.position_m, errors.heading_deg}},
           {"wrong_matches", wrong},
           {"pose_false_pairs", pose_false_pairs},
-          {"truth_mahalanobis2",
-           ErrorsOf(result.pose.Planar(), result.covariance, scene.truth.Planar()).mahalanobis2},
+          {"truth_mahalanobis2", errors.mahalanobis2},
           {"true_edges", d.true_edges},
           {"candidate_edges", d.candidate_edges},
           {"unary_edges", d.unary_edges},
