@@ -44,7 +44,8 @@ class TreeSearch {
     caps_ = line_caps.empty() ? std::vector<double>(lines.size(), 1.0) : line_caps;
   }
 
-  void Run() {
+  // Builds the candidates and the root region; false when there is nothing to search.
+  bool Prepare(FeasibleRegion* root_out) {
     BuildCandidates();
     const double min_width = DegToRad(options_.heading_bin_deg);
     FeasibleRegion root =
@@ -57,7 +58,7 @@ class TreeSearch {
         bin.positions.ClipHalfPlane({0.0, 1.0}, -prior_.bounds_min.y());
         bin.positions.ClipHalfPlane({0.0, -1.0}, prior_.bounds_max.y());
       }
-      if (root.bins.front().positions.Empty()) return;
+      if (root.bins.front().positions.Empty()) return false;
       root.UpdateBox();
     }
     const size_t n = lines_.size();
@@ -65,6 +66,14 @@ class TreeSearch {
     edge_lines_.assign(edges_.size(), 0);
     regions_.resize(n + 2);
     alive_.assign(n + 2, std::vector<char>(candidate_edge_.size(), 1));
+    *root_out = std::move(root);
+    return true;
+  }
+
+  void Run() {
+    FeasibleRegion root;
+    if (!Prepare(&root)) return;
+    const size_t n = lines_.size();
     // Iterative deepening on the bound: from what all lines with a candidate could give, down
     // by deepening_lines mean caps or deepening_fraction of the bound per pass (the larger),
     // until the visitor's own bound is reached.
@@ -88,6 +97,35 @@ class TreeSearch {
         stats_->completed_bound = pass_bound_;
       if (stats_->budget_exhausted || pass_bound_ <= visitor_bound_ || pass_bound_ <= 0.0) break;
     }
+  }
+
+  // The root branches `branches` at their pass's bound, one after the other, each with an equal
+  // share of the budgets.
+  void Resume(const UnsearchedBranches& branches) {
+    FeasibleRegion root;
+    if (branches.edges.empty() || branches.line < 0 || !Prepare(&root)) return;
+    const int line = branches.line;
+    pass_bound_ = branches.bound;
+    ++stats_->passes;
+    const double share = 1.0 / static_cast<double>(branches.edges.size());
+    for (const int edge : branches.edges) {
+      node_cap_ = stats_->nodes + std::max(1, static_cast<int>(share * options_.max_nodes));
+      leaf_cap_ = stats_->leaves + std::max(1, static_cast<int>(share * options_.max_hypotheses));
+      check_cap_ = stats_->checks + std::max(1, static_cast<int>(share * options_.max_checks));
+      if (edge < 0) {
+        decided_[line] = kClutter;
+        alive_[1] = alive_[0];
+        Search(1, root);
+        decided_[line] = kUndecided;
+      }
+      for (int c = line_offsets_[line]; edge >= 0 && c < line_offsets_[line + 1]; ++c) {
+        if (candidate_edge_[c] != edge || !Enter(0, root, c, line)) continue;
+        Search(1, regions_[1]);
+        Unassign(c, line);
+      }
+      if (!std::isfinite(visitor_bound_)) break;  // the visitor's own budget
+    }
+    stats_->budget_exhausted = true;
   }
 
  private:
@@ -181,9 +219,41 @@ class TreeSearch {
   // One node: `depth` lines decided. The next line is the first undecided one (in cap order)
   // with a candidate still alive; lines without one are clutter for free (their cap is no longer
   // in the bound).
+  // Records candidate c's assignment to `line` on the branch, and undoes it.
+  void Assign(int c, int line) {
+    const int edge = candidate_edge_[c];
+    decided_[line] = c;
+    assigned_.emplace_back(edge, line);
+    assigned_caps_ += caps_[line];
+    distinct_edges_ += edge_lines_[edge]++ == 0 ? 1 : 0;
+    for (size_t b = 0; b < basin_fit_.size(); ++b)
+      basin_fit_[b] += basin_flags_[b][c];
+  }
+  void Unassign(int c, int line) {
+    const int edge = candidate_edge_[c];
+    for (size_t b = 0; b < basin_fit_.size(); ++b)
+      basin_fit_[b] -= basin_flags_[b][c];
+    distinct_edges_ -= --edge_lines_[edge] == 0 ? 1 : 0;
+    assigned_caps_ -= caps_[line];
+    assigned_.pop_back();
+    decided_[line] = kUndecided;
+  }
+
+  // Cuts `region` by candidate c of `line` into regions_[depth + 1] (one buffer per depth,
+  // reused: copying keeps its capacity), assigns c and forward checks; false (nothing changed)
+  // when c cannot extend the branch.
+  bool Enter(size_t depth, const FeasibleRegion& region, int c, int line) {
+    const int edge = candidate_edge_[c];
+    FeasibleRegion& cut = regions_[depth + 1];
+    if (OverlapsAssigned(edge, line) || !Extend(c, region, &cut)) return false;
+    cut.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
+    Assign(c, line);
+    ForwardCheck(depth, cut, edge, line);
+    return true;
+  }
+
   void Search(size_t depth, const FeasibleRegion& region) {
-    if (stats_->nodes >= options_.max_nodes || stats_->leaves >= options_.max_hypotheses ||
-        stats_->checks >= options_.max_checks) {
+    if (stats_->nodes >= node_cap_ || stats_->leaves >= leaf_cap_ || stats_->checks >= check_cap_) {
       stats_->budget_exhausted = true;
       return;
     }
@@ -211,26 +281,17 @@ class TreeSearch {
       return;
     }
     for (int c = line_offsets_[next]; c < line_offsets_[next + 1]; ++c) {
-      const int edge = candidate_edge_[c];
-      if (!alive[c] || OverlapsAssigned(edge, next)) continue;
-      // Regions live in one buffer per depth, reused: copying keeps their capacity.
-      FeasibleRegion& cut = regions_[depth + 1];
-      if (!Extend(c, region, &cut)) continue;
-      cut.Refine(options_.max_bins, DegToRad(options_.heading_bin_deg));
-      decided_[next] = c;
-      assigned_.emplace_back(edge, next);
-      assigned_caps_ += caps_[next];
-      distinct_edges_ += edge_lines_[edge]++ == 0 ? 1 : 0;
-      for (size_t b = 0; b < basin_fit_.size(); ++b)
-        basin_fit_[b] += basin_flags_[b][c];
-      ForwardCheck(depth, cut, edge, next);
-      Search(depth + 1, cut);
-      for (size_t b = 0; b < basin_fit_.size(); ++b)
-        basin_fit_[b] -= basin_flags_[b][c];
-      distinct_edges_ -= --edge_lines_[edge] == 0 ? 1 : 0;
-      assigned_caps_ -= caps_[next];
-      assigned_.pop_back();
-      decided_[next] = kUndecided;
+      if (!alive[c] || !Enter(depth, region, c, next)) continue;
+      Search(depth + 1, regions_[depth + 1]);
+      Unassign(c, next);
+      if (depth == 0 && stats_->budget_exhausted) {  // the root's other branches: not reached
+        stats_->unsearched = {next, {}, pass_bound_};
+        for (int d = c + 1; d < line_offsets_[next + 1]; ++d) {
+          if (alive[d]) stats_->unsearched.edges.push_back(candidate_edge_[d]);
+        }
+        stats_->unsearched.edges.push_back(-1);
+        return;
+      }
     }
     decided_[next] = kClutter;
     alive_[depth + 1] = alive;
@@ -409,6 +470,9 @@ class TreeSearch {
   std::vector<std::pair<int, int>> assigned_;
   double assigned_caps_ = 0.0;
   double pass_bound_ = 0.0;
+  // Budgets: the options' own, or a share of them for each unsearched branch (Resume).
+  int node_cap_ = options_.max_nodes, leaf_cap_ = options_.max_hypotheses,
+      check_cap_ = options_.max_checks;
   double visitor_bound_ = 0.0;
   std::set<std::vector<std::pair<int, int>>> visited_;
   // Per basin: which candidates fit its pose, and how many assigned pairs do.
@@ -440,6 +504,17 @@ void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
                               const std::vector<VerifiedBasin>* basins) {
   *stats = InterpretationTreeStats();
   TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Run();
+}
+
+void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const InterpretationTreeOptions& options,
+                              const std::vector<double>& line_caps,
+                              const UnsearchedBranches& branches, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats,
+                              const std::vector<VerifiedBasin>* basins) {
+  *stats = InterpretationTreeStats();
+  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Resume(branches);
 }
 
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,

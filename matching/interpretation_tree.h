@@ -89,6 +89,15 @@ struct VerifiedBasin {
 bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
                           const std::vector<std::pair<int, int>>& fitting);
 
+// The root's branches an exhausted search did not reach in the pass the budget stopped: the
+// root's line (index into the lines), the edges it was still to take (indices into the edges; -1:
+// clutter) and that pass's bound (nats). Empty when the budget stopped the search elsewhere.
+struct UnsearchedBranches {
+  int line = -1;
+  std::vector<int> edges;
+  double bound = 0.0;
+};
+
 struct InterpretationTreeStats {
   int unary_candidates = 0;  // (edge, line) pairs passing the unary constraints
   int nodes = 0;             // tree nodes expanded
@@ -101,6 +110,7 @@ struct InterpretationTreeStats {
   // pass completed (budget, or the visitor stopped the search), the first pass's top bound (all
   // lines with a candidate); 0 when nothing was searched.
   double completed_bound = 0.0;
+  UnsearchedBranches unsearched;  // set when the budget stopped the root's first branch
 };
 
 // Called on leaves in search order, each distinct leaf once, when its bound reaches the current
@@ -116,6 +126,18 @@ void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
                               const std::vector<ObservedLine>& lines, const PriorRegion& prior,
                               const InterpretationTreeOptions& options,
                               const std::vector<double>& line_caps, const LeafVisitor& visit,
+                              InterpretationTreeStats* stats,
+                              const std::vector<VerifiedBasin>* basins = nullptr);
+
+// Searches the root branches an exhausted search (same edges, lines, prior and caps) did not
+// reach, at the bound of the pass it stopped in, each with an equal share of the options'
+// budgets; leaves as SearchInterpretationTree. `stats->budget_exhausted` stays set (the pass
+// is still not complete).
+void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
+                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
+                              const InterpretationTreeOptions& options,
+                              const std::vector<double>& line_caps,
+                              const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
                               const std::vector<VerifiedBasin>* basins = nullptr);
 

@@ -16,6 +16,10 @@ bool LocalizerOptions::Check(std::string* why) const {
     *why = "unexplained_search_share: must be in [0, 1]";
     return false;
   }
+  if (!(unsearched_branches_share >= 0.0 && unsearched_branches_share <= 1.0)) {
+    *why = "unsearched_branches_share: must be in [0, 1]";
+    return false;
+  }
   return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
 }
 
@@ -226,6 +230,10 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
       SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
     }
+    if (!stats.unsearched.edges.empty() && options_.unsearched_branches_share > 0.0) {
+      SearchUnsearchedRootBranches(edges, lines, prior, caps, stats.unsearched, visit, &basins,
+                                   &pair_tests, &result);
+    }
     context.pair_tests = nullptr;
     context.consensus_memo = nullptr;
   } else {
@@ -295,6 +303,24 @@ void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
     result->unexplained_completed_bound =
         std::max(result->unexplained_completed_bound, stats.completed_bound);
   }
+}
+
+void Localizer::SearchUnsearchedRootBranches(
+    const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
+    const PriorRegion& prior, const std::vector<double>& caps, const UnsearchedBranches& branches,
+    const LeafVisitor& visit, const std::vector<VerifiedBasin>* basins, long* pair_tests,
+    LocalizationResult* result) const {
+  const double share = options_.unsearched_branches_share;
+  *pair_tests =
+      static_cast<long>((1.0 - share) * static_cast<double>(options_.verification.max_pair_tests));
+  InterpretationTreeOptions tree = options_.tree;
+  tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
+  tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
+  tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
+  InterpretationTreeStats stats;
+  SearchUnsearchedBranches(edges, lines, prior, tree, caps, branches, visit, &stats, basins);
+  result->tree_nodes += stats.nodes;
+  result->tree_checks += stats.checks;
 }
 
 void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,

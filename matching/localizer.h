@@ -36,6 +36,11 @@ struct LocalizerOptions {
   // exhausted search's best pose leaves unexplained, as a share of the main search's (two such
   // searches at most: the time of a localisation stays within 1 + 2 x this of the budget's).
   double unexplained_search_share = 0.25;
+  // Budgets of the search of the root branches an exhausted main search did not reach in the
+  // pass it stopped in (after the searches over unexplained lines), as a share of the main
+  // search's: depth first, the first branch can take the whole budget (docs/matching.md, ninth
+  // round).
+  double unsearched_branches_share = 0.1;
 
   bool Check(std::string* why) const;
 };
@@ -128,6 +133,16 @@ class Localizer {
                               const std::vector<double>& caps,
                               const std::vector<VerifiedPose>& verified, const LeafVisitor& visit,
                               long* pair_tests, LocalizationResult* result) const;
+
+  // Searches the root branches `branches` the exhausted main search did not reach, with
+  // unsearched_branches_share of its budgets (a fresh share of the pair tests), its leaves handed
+  // to `visit`.
+  void SearchUnsearchedRootBranches(const std::vector<MatchEdge>& edges,
+                                    const std::vector<ObservedLine>& lines,
+                                    const PriorRegion& prior, const std::vector<double>& caps,
+                                    const UnsearchedBranches& branches, const LeafVisitor& visit,
+                                    const std::vector<VerifiedBasin>* basins, long* pair_tests,
+                                    LocalizationResult* result) const;
 
   // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
   // and support checks) and fills `result`.
