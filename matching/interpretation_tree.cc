@@ -103,7 +103,10 @@ class TreeSearch {
   // share of the budgets.
   void Resume(const UnsearchedBranches& branches) {
     FeasibleRegion root;
-    if (branches.edges.empty() || branches.line < 0 || !Prepare(&root)) return;
+    if (branches.edges.empty() || branches.line < 0 ||
+        branches.line >= static_cast<int>(lines_.size()) || !Prepare(&root)) {
+      return;
+    }
     const int line = branches.line;
     pass_bound_ = branches.bound;
     ++stats_->passes;
