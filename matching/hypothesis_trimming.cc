@@ -86,7 +86,7 @@ PoseRefinementResult Refit(const VerificationContext& context, const Verificatio
                            double scale) {
   auto refine = [&] {
     return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                      start, scale, options.refinement);
+                      start, scale, RefinementOptions(context, options));
   };
   if (context.consensus_memo == nullptr) return refine();
   ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
@@ -165,7 +165,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
 int OutlyingPair(const VerificationContext& context, const VerificationOptions& options,
                  const VerifiedPose& hypothesis) {
   const std::vector<LineMatch> matches = ToLineMatches(context, hypothesis.pairs);
-  const Eigen::Matrix4d& c = hypothesis.refinement.covariance;
+  // The covariance of the cost minimised (with the prior's bounds where they hold the pose).
+  const Eigen::Matrix4d& c = hypothesis.refinement.bounded_covariance;
   int worst = -1;
   double worst_chi2 = options.gate_chi2;
   for (size_t i = 0; i < matches.size(); ++i) {
@@ -196,7 +197,7 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
       match.whitening * EndpointResiduals(match, *context.camera, context.height, context.tilt,
                                           verified.pose, verified.refinement.focal_scale, &j);
   const Eigen::Matrix<double, 2, 4> wj = match.whitening * j;
-  const Eigen::Matrix4d& c = verified.refinement.covariance;
+  const Eigen::Matrix4d& c = verified.refinement.bounded_covariance;
   const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
   if (!(complement.determinant() > 1e-6)) return false;
   // Sherman-Morrison-Woodbury on the normal equations (J = d residual / d pose, whitened):

@@ -15,6 +15,11 @@ namespace linetrack {
 std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
                                      const std::vector<std::pair<int, int>>& pairs);
 
+// The verification's refinement options with the prior as bounds (PoseBounds): the prior disk
+// and heading interval widened by the options' margins, as the plausibility check widens them.
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options);
+
 // Wilson-Hilferty approximation of the chi-square quantile with `dof` degrees of freedom at
 // standard normal quantile z.
 double ChiSquareQuantile(double dof, double z);
