@@ -10,6 +10,21 @@
 
 namespace linetrack {
 
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options) {
+  PoseRefinementOptions refinement = options.refinement;
+  if (context.prior == nullptr) return refinement;
+  const PriorRegion& prior = *context.prior;
+  refinement.bounds.active = true;
+  refinement.bounds.centre = prior.centre;
+  refinement.bounds.radius_m = prior.radius + options.prior_margin_m;
+  refinement.bounds.heading = prior.heading.Mid();
+  refinement.bounds.half_width_rad =
+      0.5 * prior.heading.Width() + DegToRad(options.prior_margin_deg);
+  refinement.bounds.sigmas = options.prior_margin_sigmas;
+  return refinement;
+}
+
 namespace {
 
 // The largest subset of the hypothesis' pairs that agrees with one minimal pose (two of its

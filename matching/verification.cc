@@ -346,21 +346,6 @@ double NormalQuantile(double p) {
           1.0);
 }
 
-PoseRefinementOptions RefinementOptions(const VerificationContext& context,
-                                        const VerificationOptions& options) {
-  PoseRefinementOptions refinement = options.refinement;
-  if (context.prior == nullptr) return refinement;
-  const PriorRegion& prior = *context.prior;
-  refinement.bounds.active = true;
-  refinement.bounds.centre = prior.centre;
-  refinement.bounds.radius_m = prior.radius + options.prior_margin_m;
-  refinement.bounds.heading = prior.heading.Mid();
-  refinement.bounds.half_width_rad =
-      0.5 * prior.heading.Width() + DegToRad(options.prior_margin_deg);
-  refinement.bounds.sigmas = options.prior_margin_sigmas;
-  return refinement;
-}
-
 LineFitModel FitModel(const VerificationContext& context, const VerificationOptions& options) {
   LineFitModel model;
   model.offset_px = context.noise.offset_px;
