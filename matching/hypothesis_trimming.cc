@@ -1,9 +1,12 @@
 // Cleaning a hypothesis before it is verified: the consensus restart, the trimming of residual
-// outliers, the per-pair outlier test, and the leave-one-out rivals of the decision.
+// outliers, the per-pair outlier test, the leave-one-out rivals of the decision and
+// the refinement over the pairs an answer vouches for.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
+
+#include <Eigen/Eigenvalues>
 
 #include "matching/verification.h"
 #include "matching/verification_internal.h"
@@ -225,6 +228,37 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
   // The same identity for the covariance: (C^-1 - J_i' J_i)^-1 = C + C J_i' (I - H_ii)^-1 J_i C.
   if (covariance != nullptr) *covariance = c + c * wj.transpose() * complement_inverse * wj * c;
   return true;
+}
+
+PoseRefinementResult VouchedRefinement(const VerificationContext& context,
+                                       const VerificationOptions& options,
+                                       const VerifiedPose& verified,
+                                       const std::vector<std::pair<int, int>>& reported) {
+  const std::vector<LineMatch> matches = ToLineMatches(context, verified.pairs);
+  const Eigen::Matrix4d& c = verified.refinement.covariance;
+  std::vector<LineMatch> kept;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (std::find(reported.begin(), reported.end(), verified.pairs[i]) != reported.end()) {
+      kept.push_back(matches[i]);
+      continue;
+    }
+    Eigen::Matrix<double, 2, 4> j;
+    EndpointResiduals(matches[i], *context.camera, context.height, context.tilt, verified.pose,
+                      verified.refinement.focal_scale, &j);
+    const Eigen::Matrix<double, 2, 4> wj = matches[i].whitening * j;
+    const Eigen::Matrix2d leverage = wj * c * wj.transpose();
+    // The variance along the worst direction grows by 1 / (1 - largest eigenvalue) without it.
+    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(leverage, Eigen::EigenvaluesOnly)
+            .eigenvalues()
+            .maxCoeff() < options.max_unreported_leverage) {
+      kept.push_back(matches[i]);
+    }
+  }
+  if (kept.size() == matches.size()) return verified.refinement;
+  // Refitted under the same cost as the verification (the prior's bounds included), so the kept
+  // pairs cannot slide out of the prior; the result's covariance is the image information alone.
+  return RefinePose(kept, *context.camera, context.height, context.tilt, verified.pose,
+                    verified.refinement.focal_scale, RefinementOptions(context, options));
 }
 
 std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,

@@ -3,6 +3,7 @@
 #include "matching/line_fit.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -75,12 +76,16 @@ class TreeSearch {
       ++with_candidates;
     }
     if (with_candidates == 0) return;
+    stats_->completed_bound = top;
     const double step = options_.deepening_lines * top / with_candidates;
     for (double pass = top - std::max(step, options_.deepening_fraction * top);;
          pass -= std::max(step, options_.deepening_fraction * pass)) {
       pass_bound_ = std::max(pass, 0.0);
       ++stats_->passes;
       Search(0, root);
+      // The visitor stops the search by an infinite bound (its own budget): not a completed pass.
+      if (!stats_->budget_exhausted && std::isfinite(visitor_bound_))
+        stats_->completed_bound = pass_bound_;
       if (stats_->budget_exhausted || pass_bound_ <= visitor_bound_ || pass_bound_ <= 0.0) break;
     }
   }

@@ -96,6 +96,11 @@ struct InterpretationTreeStats {
   int leaves = 0;            // leaves handed to the visitor
   int passes = 0;            // iterative-deepening passes
   bool budget_exhausted = false;
+  // Bound (nats, sum of line caps) of the last iterative-deepening pass that ran to its end: every
+  // leaf whose bound reaches it was visited or cut as unable to beat the visitor's bound. When no
+  // pass completed (budget, or the visitor stopped the search), the first pass's top bound (all
+  // lines with a candidate); 0 when nothing was searched.
+  double completed_bound = 0.0;
 };
 
 // Called on leaves in search order, each distinct leaf once, when its bound reaches the current

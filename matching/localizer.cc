@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <set>
 
@@ -80,15 +81,32 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
   return regions_->Query(query);
 }
 
-LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
-  CheckProblem(problem);
-  LocalizationResult result;
-  const std::vector<int> ids = CandidateEdges(problem);
-  result.candidate_edges = static_cast<int>(ids.size());
-  const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
-  const std::vector<ObservedLine> lines = PrepareLines(
-      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
+namespace {
 
+// A trimmed hypothesis already verified: its pose and focal scale, and the guided-matching pair
+// tests its verification cost.
+struct RematchedHypothesis {
+  Pose3Dof pose;
+  double focal_scale = 1.0;
+  long pair_tests = 0;
+};
+
+// True when the trimmed hypothesis `leaf` (pairs as those of `known`) is one already verified
+// (SameRefinedPose); then adds the pair tests its verification cost to `pair_tests`.
+bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypothesis>& known,
+                     long* pair_tests) {
+  for (const RematchedHypothesis& k : known) {
+    if (SameRefinedPose(k.pose, k.focal_scale, leaf.pose, leaf.refinement.focal_scale)) {
+      *pair_tests += k.pair_tests;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+PriorRegion Localizer::Prior(const LocalizationProblem& problem) const {
   PriorRegion prior;
   prior.centre = {problem.prior.x, problem.prior.y};
   prior.radius = problem.delta_t;
@@ -101,6 +119,19 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     prior.bounds_min = area_->BoundsMin();
     prior.bounds_max = area_->BoundsMax();
   }
+  return prior;
+}
+
+LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const {
+  CheckProblem(problem);
+  LocalizationResult result;
+  const std::vector<int> ids = CandidateEdges(problem);
+  result.candidate_edges = static_cast<int>(ids.size());
+  const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
+  const std::vector<ObservedLine> lines = PrepareLines(
+      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
+
+  const PriorRegion prior = Prior(problem);
   VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
                               &occlusion_, &prior, area_,    options_.noise};
   std::vector<VerifiedPose> verified;
@@ -124,6 +155,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     context.pair_tests = &pair_tests;
     ConsensusMemo consensus_memo;
     context.consensus_memo = &consensus_memo;
+    // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
+    std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
       const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       for (const auto& pairs : verified_pairs) {
@@ -154,7 +187,19 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
         return bound;
       }
+      // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
+      // agreeing pairs): guided matching from it would give the same pose again, which the
+      // verified poses, basins and best evidence already hold. Its share of the work budget still
+      // counts.
+      std::vector<std::pair<int, int>> trimmed = leaf.pairs;
+      std::sort(trimmed.begin(), trimmed.end());
+      std::vector<RematchedHypothesis>& known = rematched[std::move(trimmed)];
+      if (AlreadyVerified(leaf, known, &pair_tests)) {
+        return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
+      }
+      const long tests_before = pair_tests;
       VerifiedPose v = Rematch(context, leaf, vo);
+      known.push_back({leaf.pose, leaf.refinement.focal_scale, pair_tests - tests_before});
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
         best = std::max(best, v.evidence.Score());
@@ -176,6 +221,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     result.unary_candidates = stats.unary_candidates;
     result.tree_nodes = stats.nodes;
     result.tree_checks = stats.checks;
+    result.tree_completed_bound = stats.completed_bound;
     result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
     if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
       SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
@@ -246,6 +292,8 @@ void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
         &stats, nullptr);
     result->tree_nodes += stats.nodes;
     result->tree_checks += stats.checks;
+    result->unexplained_completed_bound =
+        std::max(result->unexplained_completed_bound, stats.completed_bound);
   }
 }
 
@@ -335,9 +383,15 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.found = true;
   result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
   result.cam_from_world = CamFromWorld(result.pose);
-  result.covariance = best.refinement.covariance.topLeftCorner<3, 3>();
-  result.position_sigma_m = best.refinement.position_sigma_m;
-  result.heading_sigma_rad = best.refinement.heading_sigma_rad;
+  // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
+  // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
+  const PoseRefinementResult vouched = VouchedRefinement(context, vo, best, reported);
+  const bool observable = vouched.position_sigma_m <= vo.max_position_sigma_m &&
+                          vouched.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
+  const PoseRefinementResult& uncertainty = observable ? vouched : best.refinement;
+  result.covariance = uncertainty.covariance.topLeftCorner<3, 3>();
+  result.position_sigma_m = uncertainty.position_sigma_m;
+  result.heading_sigma_rad = uncertainty.heading_sigma_rad;
   for (const auto& [e, l] : reported)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());

@@ -76,6 +76,11 @@ struct LocalizationResult {
   int hypotheses = 0;   // hypotheses verified (pose evaluations)
   int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
+  // The main tree search's InterpretationTreeStats::completed_bound (nats): leaves it did not
+  // visit have a bound below it when the budget ran out (docs/matching.md, eighth round).
+  double tree_completed_bound = 0.0;
+  // The largest completed_bound of the searches over unexplained lines (0 when none ran).
+  double unexplained_completed_bound = 0.0;
   std::string reason;               // why no pose was accepted (empty when found)
   std::vector<Finalist> finalists;  // the distinct plausible poses compared, best first
   // Uncertainty of the accepted pose under the line noise model (valid when found): covariance
@@ -101,6 +106,10 @@ class Localizer {
 
   // The model edges possibly visible for the problem's prior (sorted ids).
   std::vector<int> CandidateEdges(const LocalizationProblem& problem) const;
+
+  // The tree's prior region for the problem: the prior disk and heading interval at the camera
+  // height, clipped to the navigable area's bounding box when there is an area.
+  PriorRegion Prior(const LocalizationProblem& problem) const;
 
   const CameraIntrinsics& camera() const { return camera_; }
   const LocalizerOptions& options() const { return options_; }

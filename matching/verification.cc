@@ -325,27 +325,6 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
   return matches;
 }
 
-double ChiSquareQuantile(double dof, double z) {
-  const double k = std::max(dof, 1.0);
-  const double c = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - c + z * std::sqrt(c), 3.0);
-}
-
-double NormalQuantile(double p) {
-  const double q = std::sqrt(-2.0 * std::log(1.0 - p));
-  return -(((((-7.784894002430293e-03 * q - 3.223964580411365e-01) * q - 2.400758277161838e+00) *
-                 q -
-             2.549732539343734e+00) *
-                q +
-            4.374664141464968e+00) *
-               q +
-           2.938163982698783e+00) /
-         ((((7.784695709041462e-03 * q + 3.224671290700398e-01) * q + 2.445134137142996e+00) * q +
-           3.754408661907416e+00) *
-              q +
-          1.0);
-}
-
 LineFitModel FitModel(const VerificationContext& context, const VerificationOptions& options) {
   LineFitModel model;
   model.offset_px = context.noise.offset_px;
@@ -359,8 +338,11 @@ LineFitModel FitModel(const VerificationContext& context, const VerificationOpti
 bool VerificationOptions::Check(std::string* why) const {
   if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
       max_pair_tests < 1 || !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
-      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0)) {
-    *why = "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1)";
+      !(visibility_step_px > 0.0) || !(ambiguity_nats >= 0.0) || !(report_nats >= 0.0) ||
+      !(max_unreported_leverage > 0.0 && max_unreported_leverage <= 1.0)) {
+    *why =
+        "verification: gates > 0, guided_rounds >= 1, min_matches >= 2, quantile in [0.975, 1), "
+        "max_unreported_leverage in (0, 1]";
     return false;
   }
   return refinement.Check(why);
@@ -608,6 +590,12 @@ bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
 bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options) {
   return std::hypot(a.x - b.x, a.y - b.y) <= options.same_pose_m &&
          std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(options.same_pose_deg);
+}
+
+bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b) {
+  return std::abs(a.x - b.x) <= 0.01 && std::abs(a.y - b.y) <= 0.01 &&
+         std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(0.1) &&
+         std::abs(scale_a - scale_b) <= 1e-3;
 }
 
 }  // namespace linetrack

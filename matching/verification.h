@@ -69,6 +69,10 @@ struct VerificationOptions {
   // Observability: an accepted pose's standard deviations (noise model) must be below these.
   double max_position_sigma_m = 0.5;
   double max_heading_sigma_deg = 5.0;
+  // The accepted pose's covariance does not lean on an unreported pair whose leverage (largest
+  // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
+  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching.md section 6).
+  double max_unreported_leverage = 0.75;
   // A pose may leave the prior disk by prior_margin_m plus prior_margin_sigmas of its position
   // standard deviation, and the heading interval likewise.
   double prior_margin_m = 0.05;
@@ -229,6 +233,17 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
                                                         const VerificationOptions& options,
                                                         const VerifiedPose& verified);
 
+// The refinement of a verified pose over the pairs it can lean on: `reported` (its reported
+// correspondences) and those of its other pairs whose leverage at its pose (largest eigenvalue of
+// W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
+// high-leverage unreported pairs left out at once); its own refinement when none is left out. An
+// unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
+// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107).
+PoseRefinementResult VouchedRefinement(const VerificationContext& context,
+                                       const VerificationOptions& options,
+                                       const VerifiedPose& verified,
+                                       const std::vector<std::pair<int, int>>& reported);
+
 // The poses a verified pose's pairs give without one of its influential pairs (the first-order
 // deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
 // hypothesis_quantile of chi2(3)), each refined and verified by Rematch without that pair
@@ -261,5 +276,11 @@ bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
 
 // True when two poses are the same answer (within same_pose_m and same_pose_deg).
 bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options);
+
+// True when two refined hypotheses of the same pairs are one pose: positions within 1 cm,
+// headings within 0.1 degree and focal scales within 0.1 % (a hundred times the verification's
+// Levenberg-Marquardt step tolerance, far below the poses' noise of about 7 cm and 0.3 degree).
+// Guided matching from either gives the same verified pose (the localizer verifies it once).
+bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b);
 
 }  // namespace linetrack

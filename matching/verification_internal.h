@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "matching/pose_refinement.h"
+#include "matching/quantiles.h"
 #include "matching/verification.h"
 
 namespace linetrack {
@@ -19,13 +20,5 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
 // and heading interval widened by the options' margins, as the plausibility check widens them.
 PoseRefinementOptions RefinementOptions(const VerificationContext& context,
                                         const VerificationOptions& options);
-
-// Wilson-Hilferty approximation of the chi-square quantile with `dof` degrees of freedom at
-// standard normal quantile z.
-double ChiSquareQuantile(double dof, double z);
-
-// Standard normal quantile for p in (0.975, 1) (Acklam's rational approximation, upper tail;
-// relative error below 1.2e-9).
-double NormalQuantile(double p);
 
 }  // namespace linetrack

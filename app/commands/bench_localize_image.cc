@@ -72,9 +72,8 @@ Outcome Judge(const RenderedCase& c, const LocalizationResult& result,
         const std::vector<int>& ids = true_edges_of_line[m.second];
         return std::find(ids.begin(), ids.end(), m.first) != ids.end();
       });
-  const double dp = std::hypot(result.pose.x - c.scene.truth.x, result.pose.y - c.scene.truth.y);
-  const double dh = RadToDeg(std::abs(WrapAngle(result.pose.heading - c.scene.truth.heading)));
-  return JudgeMatch(result.found, all_true, dp, dh);
+  return JudgeMatch(result.found, all_true,
+                    ErrorsOf(result.pose.Planar(), result.covariance, c.scene.truth.Planar()));
 }
 
 double Quantile(std::vector<double> v, double q) {

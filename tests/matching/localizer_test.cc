@@ -1,12 +1,14 @@
 // The localizer end to end on synthetic scenes of the hall (the paper's section 4.1, QI2 prior):
 // most scenes answered with correct correspondences, none answered wrong, the same result twice,
 // the search budget respected with 200 clutter lines, the truth's diagnosis consistent, and bad
-// problems rejected; and the fourth and fifth rounds' wrong poses (seeds 6 and 5) not answered
-// wrong.
+// problems rejected; the fourth and fifth rounds' wrong poses (seeds 6 and 5, QI2/QI3 priors) not
+// answered wrong; the seventh round's answer covariance without an unreported high-leverage pair
+// (seed 2 QI1); the tree's completed-pass bound when its budget runs out (eighth round).
 #include "matching/localizer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "matching/diagnosis.h"
@@ -43,11 +45,10 @@ class LocalizerTest : public ::testing::Test {
     return GenerateScenes(model_, area_, options);
   }
 
-  // The benchmark's scenes (bench match --seed SEED --series qi2 / qi3: delta_t, delta_phi 0.5 m,
-  // 15 deg / 0.75 m, 20 deg; a scene does not depend on the count), and the localizer's result on
-  // one of them with an expectation that it is not wrong.
-  LocalizationResult LocalizeNotWrong(uint64_t seed, double delta_t, double delta_phi_deg,
-                                      int index, SyntheticScene* scene) const {
+  // A benchmark scene (bench match --seed S, prior delta_t / delta_phi; a scene does not depend
+  // on the count) and the localizer's result on it.
+  LocalizationResult LocalizeBenchmarkScene(uint64_t seed, double delta_t, double delta_phi_deg,
+                                            int index, SyntheticScene* scene) const {
     SyntheticSceneOptions options;
     options.seed = seed;
     options.count = index + 1;
@@ -55,7 +56,14 @@ class LocalizerTest : public ::testing::Test {
     options.delta_phi = DegToRad(delta_phi_deg);
     *scene = GenerateScenes(model_, area_, options).at(index);
     const Localizer localizer(model_, &regions_, &area_, PaperSyntheticCamera());
-    const LocalizationResult r = localizer.Localize(ProblemOf(*scene));
+    return localizer.Localize(ProblemOf(*scene));
+  }
+
+  // A benchmark scene (bench match --seed S --series qi2 / qi3: delta_t, delta_phi 0.5 m, 15 deg
+  // / 0.75 m, 20 deg), expecting an answer not to be wrong.
+  LocalizationResult LocalizeNotWrong(uint64_t seed, double delta_t, double delta_phi_deg,
+                                      int index, SyntheticScene* scene) const {
+    const LocalizationResult r = LocalizeBenchmarkScene(seed, delta_t, delta_phi_deg, index, scene);
     if (r.found) {
       EXPECT_LE(std::hypot(r.pose.x - scene->truth.x, r.pose.y - scene->truth.y), kWrongPositionM);
       EXPECT_LE(RadToDeg(std::abs(WrapAngle(r.pose.heading - scene->truth.heading))),
@@ -63,6 +71,7 @@ class LocalizerTest : public ::testing::Test {
     }
     return r;
   }
+  // Seed 6 at QI3 (bench match --seed 6 --series qi3), expecting an answer not to be wrong.
   LocalizationResult LocalizeSeed6Qi3NotWrong(int index, SyntheticScene* scene) const {
     return LocalizeNotWrong(6, 0.75, 20.0, index, scene);
   }
@@ -221,6 +230,28 @@ TEST_F(LocalizerTest, PoseHeldInsideThePriorRivalsAsUnobservable) {
   }
 }
 
+// Seed 2 QI1 scene 107 (seventh round): 7 true pairs leave the pose loose along a valley
+// (position sigma 0.22 m, heading 1.3 deg); guided matching added a clutter line (line 9) to edge
+// 57 with leverage 0.999, unreported, which alone fixed the heading to 0.22 deg sigma. The
+// answer, 0.64 m and 3.5 deg from the truth, claimed that precision: the truth's squared
+// Mahalanobis distance was 12 715. Its covariance now leans only on pairs it vouches for.
+TEST_F(LocalizerTest, CovarianceDoesNotLeanOnAnUnreportedHighLeveragePair) {
+  SyntheticScene scene;
+  const LocalizationResult r = LocalizeBenchmarkScene(2, 0.30, 10.0, 107, &scene);
+  ASSERT_TRUE(r.found) << r.reason;
+  const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
+  for (const auto& m : r.matches)
+    EXPECT_TRUE(truth.count(m) > 0) << "edge " << m.first << " line " << m.second;
+  EXPECT_EQ(std::count(r.matches.begin(), r.matches.end(), std::make_pair(57, 9)), 0);
+  // The truth inside the answer's 99.9 % confidence region (chi2(3) quantile).
+  constexpr double kRegionChi2 = 16.27;
+  const Eigen::Vector3d d(WrapAngle(scene.truth.heading - r.pose.heading), scene.truth.x - r.pose.x,
+                          scene.truth.y - r.pose.y);
+  EXPECT_LE(d.dot(r.covariance.ldlt().solve(d)), kRegionChi2);
+  // The heading sigma of the 7 reported pairs (1.33 deg), not the 0.22 deg of the false pair.
+  EXPECT_GT(RadToDeg(r.heading_sigma_rad), 1.0);
+}
+
 // The rule on its own: scene 409's verified pose holds (19, 4) and (38, 5); the truth's leaf
 // gives line 4 to edge 38. Pairs that fit the pose, or lines the pose does not explain, are no
 // contradiction.
@@ -230,6 +261,58 @@ TEST(AssignsLineOtherwiseTest, OnlyALineOnAnotherEdgeContradicts) {
   EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {19, 4}}, fitting));
   EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {35, 7}}, fitting));
   EXPECT_FALSE(AssignsLineOtherwise({}, fitting));
+}
+
+// The tree's completed_bound (docs/matching.md, eighth round): when the budget stops the search,
+// every leaf whose bound reaches the last completed pass's bound was visited. Checked against the
+// complete search (unit caps: a leaf's bound is its number of lines) on seed 1 QI1 scene 0.
+TEST_F(LocalizerTest, LeavesAboveTheCompletedPassBoundAreVisitedWhenTheBudgetRunsOut) {
+  SyntheticScene scene;
+  LocalizeBenchmarkScene(1, 0.30, 10.0, 0, &scene);
+  const LocalizationProblem problem = ProblemOf(scene);
+  const Localizer localizer(model_, &regions_, &area_, PaperSyntheticCamera());
+  const std::vector<MatchEdge> edges = PrepareEdges(model_, localizer.CandidateEdges(problem));
+  const std::vector<ObservedLine> lines =
+      PrepareLines(problem.lines, localizer.camera(), problem.tilt, LineNoise(),
+                   InterpretationTreeOptions().vertical_gate_sigmas);
+  const PriorRegion prior = localizer.Prior(problem);
+  auto keys = [](const std::vector<Hypothesis>& leaves) {
+    std::set<std::vector<std::pair<int, int>>> out;
+    for (Hypothesis h : leaves) {
+      std::sort(h.pairs.begin(), h.pairs.end());
+      out.insert(h.pairs);
+    }
+    return out;
+  };
+  InterpretationTreeOptions unlimited;
+  unlimited.max_nodes = 1000000;
+  unlimited.max_checks = 100000000;
+  unlimited.max_hypotheses = 1000000;
+  InterpretationTreeStats full_stats;
+  const std::vector<Hypothesis> all =
+      GenerateHypotheses(edges, lines, prior, unlimited, &full_stats);
+  ASSERT_FALSE(full_stats.budget_exhausted);
+  EXPECT_EQ(full_stats.completed_bound, 0.0);  // every pass completed, down to bound 0
+  ASSERT_FALSE(all.empty());
+  int completed_passes_seen = 0;
+  for (const int max_nodes : {1, 20, 50, 100, 200, 400, 800}) {
+    InterpretationTreeOptions options = unlimited;
+    options.max_nodes = max_nodes;
+    InterpretationTreeStats stats;
+    const std::set<std::vector<std::pair<int, int>>> visited =
+        keys(GenerateHypotheses(edges, lines, prior, options, &stats));
+    if (!stats.budget_exhausted) continue;
+    completed_passes_seen += stats.passes >= 2 ? 1 : 0;  // the budget stopped a later pass
+    for (Hypothesis h : all) {
+      if (h.bound < stats.completed_bound) continue;
+      std::sort(h.pairs.begin(), h.pairs.end());
+      EXPECT_TRUE(visited.count(h.pairs) > 0)
+          << "max_nodes " << max_nodes << ": a leaf of bound " << h.bound << " >= completed bound "
+          << stats.completed_bound << " not visited";
+    }
+  }
+  // Not vacuous: some budget stopped the search after a completed pass.
+  EXPECT_GT(completed_passes_seen, 0);
 }
 
 }  // namespace

@@ -155,5 +155,30 @@ TEST_F(VerificationTest, ConsensusMemoGivesTheSameTrimmedHypothesis) {
   EXPECT_GE(restarted, kScenes / 2);
 }
 
+// Sibling leaves trimmed to the same pairs are verified once when their refined poses agree
+// (SameRefinedPose): the true pairs refined from the truth and from a start 0.3 m and 3 degrees
+// off converge to one pose within its tolerance; poses just beyond it are distinct.
+TEST_F(VerificationTest, SameRefinedPoseFromDistantStarts) {
+  constexpr double kStartOffsetM = 0.3;
+  constexpr double kStartOffsetDeg = 3.0;
+  for (const SyntheticScene& scene : Scenes(23, false)) {
+    const VerificationContext context = Context(scene);
+    const Pose3Dof truth = scene.truth.Planar();
+    const Pose3Dof moved{truth.x + kStartOffsetM, truth.y - kStartOffsetM,
+                         truth.heading + DegToRad(kStartOffsetDeg)};
+    const VerifiedPose a = RefineHypothesis(context, scene.matches, {truth}, options_);
+    const VerifiedPose b = RefineHypothesis(context, scene.matches, {moved}, options_);
+    EXPECT_TRUE(SameRefinedPose(a.pose, a.refinement.focal_scale, b.pose, b.refinement.focal_scale))
+        << "scene " << scene.index << ": " << a.pose.x - b.pose.x << " m, "
+        << RadToDeg(a.pose.heading - b.pose.heading) << " deg";
+    const double s = a.refinement.focal_scale;
+    EXPECT_FALSE(SameRefinedPose(a.pose, s, {a.pose.x + 0.011, a.pose.y, a.pose.heading}, s));
+    EXPECT_FALSE(SameRefinedPose(a.pose, s, {a.pose.x, a.pose.y - 0.011, a.pose.heading}, s));
+    EXPECT_FALSE(
+        SameRefinedPose(a.pose, s, {a.pose.x, a.pose.y, a.pose.heading + DegToRad(0.11)}, s));
+    EXPECT_FALSE(SameRefinedPose(a.pose, s, a.pose, s + 0.0011));
+  }
+}
+
 }  // namespace
 }  // namespace linetrack
