@@ -214,12 +214,21 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     const double a = std::abs(r);
     return options.huber_px > 0.0 && a > options.huber_px ? options.huber_px / a : 1.0;
   };
-  // Normal equations at (pose, scale) on the whitened residuals; returns the raw sum of squared
-  // pixel residuals and (in *chi2) of the whitened ones.
+  // One pass over the pairs at (pose, scale): the normal equations of the whitened residuals,
+  // Huber-weighted when `robust`, in (jtj, jtr); optionally those of the other weighting in
+  // (other_jtj, other_jtr) and the Huber cost in *huber_cost. Returns the raw sum of squared pixel
+  // residuals and (in *chi2) of the whitened ones.
   auto normal_equations = [&](const Pose3Dof& pose, double scale, bool robust, Eigen::Matrix4d* jtj,
-                              Eigen::Vector4d* jtr, double* chi2) {
+                              Eigen::Vector4d* jtr, double* chi2,
+                              Eigen::Matrix4d* other_jtj = nullptr,
+                              Eigen::Vector4d* other_jtr = nullptr, double* huber_cost = nullptr) {
     jtj->setZero();
     jtr->setZero();
+    if (other_jtj != nullptr) {
+      other_jtj->setZero();
+      other_jtr->setZero();
+    }
+    if (huber_cost != nullptr) *huber_cost = 0.0;
     double squares = 0.0;
     *chi2 = 0.0;
     const PoseView view = ViewOf(pose, height, tilt);
@@ -229,47 +238,60 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
       squares += raw.squaredNorm();
       const Eigen::Vector2d r = m.whitening * raw;
       *chi2 += r.squaredNorm();
+      if (huber_cost != nullptr) *huber_cost += huber(r[0]) + huber(r[1]);
       j = m.whitening * j;
       if (!with_scale) j.col(3).setZero();
       for (int k = 0; k < 2; ++k) {
         const double w = robust ? weight(r[k]) : 1.0;
         *jtj += w * j.row(k).transpose() * j.row(k);
         *jtr += w * j.row(k).transpose() * r[k];
+        if (other_jtj != nullptr) {
+          const double v = robust ? 1.0 : weight(r[k]);
+          *other_jtj += v * j.row(k).transpose() * j.row(k);
+          *other_jtr += v * j.row(k).transpose() * r[k];
+        }
       }
     }
     if (with_scale) {
       (*jtj)(3, 3) += prior_weight * prior_weight;
       (*jtr)(3) += prior_weight * prior_weight * (scale - 1.0);
+      if (other_jtj != nullptr) {
+        (*other_jtj)(3, 3) += prior_weight * prior_weight;
+        (*other_jtr)(3) += prior_weight * prior_weight * (scale - 1.0);
+      }
     }
     return squares;
   };
-  // The bounds' border at a pose (widened by the image evidence's sigmas there, from the plain
-  // information); only computed when the pose leaves the unwidened region (else no residual).
+  // The bounds' border (widened by the image evidence's sigmas, from the plain information
+  // `plain_jtj` at the pose); only needed when the pose leaves the unwidened region (else no
+  // residual).
   auto outside_unwidened = [&](const Pose3Dof& pose) {
     return bounds.active &&
            (std::hypot(pose.x - bounds.centre.x(), pose.y - bounds.centre.y()) > bounds.radius_m ||
             std::abs(WrapAngle(pose.heading - bounds.heading)) > bounds.half_width_rad);
   };
-  auto border_at = [&](const Pose3Dof& pose, double scale) {
-    Eigen::Matrix4d jtj;
-    Eigen::Vector4d jtr;
-    double chi2 = 0.0;
-    normal_equations(pose, scale, false, &jtj, &jtr, &chi2);
-    const auto [position_sigma, heading_sigma] = SigmasOf(jtj, dof);
+  auto border_of = [&](const Eigen::Matrix4d& plain_jtj) {
+    const auto [position_sigma, heading_sigma] = SigmasOf(plain_jtj, dof);
     return std::make_pair(bounds.radius_m + Widening(bounds, position_sigma),
                           bounds.half_width_rad + Widening(bounds, heading_sigma));
   };
   auto cost_at = [&](const Pose3Dof& pose, double scale) {
     double cost = 0.0;
+    const double p = prior_weight * (scale - 1.0);
+    if (outside_unwidened(pose)) {
+      // The Huber cost and the plain information for the border in one pass.
+      Eigen::Matrix4d plain_jtj;
+      Eigen::Vector4d plain_jtr;
+      double chi2 = 0.0;
+      normal_equations(pose, scale, false, &plain_jtj, &plain_jtr, &chi2, nullptr, nullptr, &cost);
+      const auto [radius, half_width] = border_of(plain_jtj);
+      cost += BoundsResiduals(bounds, pose, radius, half_width).squaredNorm();
+      return cost + p * p;
+    }
     const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
       const Eigen::Vector2d r = m.whitening * EndpointResiduals(m, camera, view, scale, nullptr);
       cost += huber(r[0]) + huber(r[1]);
-    }
-    const double p = prior_weight * (scale - 1.0);
-    if (outside_unwidened(pose)) {
-      const auto [radius, half_width] = border_at(pose, scale);
-      cost += BoundsResiduals(bounds, pose, radius, half_width).squaredNorm();
     }
     return cost + p * p;
   };
@@ -281,9 +303,14 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
   double chi2 = 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
-    normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2);
-    if (outside_unwidened(result.pose)) {
-      const auto [radius, half_width] = border_at(result.pose, result.focal_scale);
+    if (!outside_unwidened(result.pose)) {
+      normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2);
+    } else {
+      Eigen::Matrix4d plain_jtj;
+      Eigen::Vector4d plain_jtr;
+      normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2, &plain_jtj,
+                       &plain_jtr);
+      const auto [radius, half_width] = border_of(plain_jtj);
       Eigen::Matrix<double, 2, 3> jb;
       const Eigen::Vector2d rb = BoundsResiduals(bounds, result.pose, radius, half_width, &jb);
       jtj.topLeftCorner<3, 3>() += jb.transpose() * jb;
@@ -323,13 +350,19 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     }
   }
   result.pose.heading = WrapAngle(result.pose.heading);
+  // The plain normal equations at the end (and, where the bounds may hold the pose, the robust
+  // ones for the held test) in one pass.
+  const bool outside = outside_unwidened(result.pose);
+  Eigen::Matrix4d robust_jtj;
+  Eigen::Vector4d robust_jtr;
   const double squares =
-      normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr, &result.chi2);
+      normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr, &result.chi2,
+                       outside ? &robust_jtj : nullptr, outside ? &robust_jtr : nullptr);
   result.rms_px = std::sqrt(squares / (2.0 * n));
   // Pose uncertainty: the inverse of the information (the scale, when estimated, included).
   UncertaintyOf(jtj, dof, &result.covariance, &result.position_sigma_m, &result.heading_sigma_rad);
   result.bounded_covariance = result.covariance;
-  if (outside_unwidened(result.pose)) {
+  if (outside) {
     // Where the pose is held at the border, the cost minimised has the bounds' information too.
     const double radius = bounds.radius_m + Widening(bounds, result.position_sigma_m);
     const double half_width = bounds.half_width_rad + Widening(bounds, result.heading_sigma_rad);
@@ -339,10 +372,6 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     result.bounds_excess_rad = rb[1] * bounds.softness_rad;
     // Held: outside by a hair, or stopped inside where the image's (robust) Gauss-Newton step
     // leads out of the bounds (LM stops at the wall when the border grows with the sigmas).
-    Eigen::Matrix4d robust_jtj;
-    Eigen::Vector4d robust_jtr;
-    double robust_chi2 = 0.0;
-    normal_equations(result.pose, result.focal_scale, true, &robust_jtj, &robust_jtr, &robust_chi2);
     Eigen::Vector4d step = Eigen::Vector4d::Zero();
     step.head(dof) = -robust_jtj.topLeftCorner(dof, dof).ldlt().solve(robust_jtr.head(dof));
     const Pose3Dof target{result.pose.x + step[1], result.pose.y + step[2],
