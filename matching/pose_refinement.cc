@@ -262,9 +262,8 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     }
     return squares;
   };
-  // The bounds' border (widened by the image evidence's sigmas, from the plain information
-  // `plain_jtj` at the pose); only needed when the pose leaves the unwidened region (else no
-  // residual).
+  // The bounds' border, widened by the image evidence's sigmas from the plain information
+  // `plain_jtj` at a pose; only used when the pose leaves the unwidened region (else no residual).
   auto outside_unwidened = [&](const Pose3Dof& pose) {
     return bounds.active &&
            (std::hypot(pose.x - bounds.centre.x(), pose.y - bounds.centre.y()) > bounds.radius_m ||
@@ -275,23 +274,33 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
     return std::make_pair(bounds.radius_m + Widening(bounds, position_sigma),
                           bounds.half_width_rad + Widening(bounds, heading_sigma));
   };
-  auto cost_at = [&](const Pose3Dof& pose, double scale) {
-    double cost = 0.0;
-    const double p = prior_weight * (scale - 1.0);
-    if (outside_unwidened(pose)) {
-      // The Huber cost and the plain information for the border in one pass.
+  // The border of the current step: widened by the sigmas of the image evidence at the iterate,
+  // held fixed during the step's trials as the bounds' Jacobian holds them (the trials then need
+  // the residuals only). Computed when first needed in a step (most refinements stay inside).
+  std::pair<double, double> border{bounds.radius_m, bounds.half_width_rad};
+  bool border_ready = false;
+  auto step_border = [&]() {
+    if (!border_ready) {
       Eigen::Matrix4d plain_jtj;
       Eigen::Vector4d plain_jtr;
-      double chi2 = 0.0;
-      normal_equations(pose, scale, false, &plain_jtj, &plain_jtr, &chi2, nullptr, nullptr, &cost);
-      const auto [radius, half_width] = border_of(plain_jtj);
-      cost += BoundsResiduals(bounds, pose, radius, half_width).squaredNorm();
-      return cost + p * p;
+      double plain_chi2 = 0.0;
+      normal_equations(result.pose, result.focal_scale, false, &plain_jtj, &plain_jtr, &plain_chi2);
+      border = border_of(plain_jtj);
+      border_ready = true;
     }
+    return border;
+  };
+  auto cost_at = [&](const Pose3Dof& pose, double scale) {
+    double cost = 0.0;
     const PoseView view = ViewOf(pose, height, tilt);
     for (const LineMatch& m : matches) {
       const Eigen::Vector2d r = m.whitening * EndpointResiduals(m, camera, view, scale, nullptr);
       cost += huber(r[0]) + huber(r[1]);
+    }
+    const double p = prior_weight * (scale - 1.0);
+    if (outside_unwidened(pose)) {
+      const auto [radius, half_width] = step_border();
+      cost += BoundsResiduals(bounds, pose, radius, half_width).squaredNorm();
     }
     return cost + p * p;
   };
@@ -303,18 +312,27 @@ PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
   double chi2 = 0.0;
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
+    border_ready = false;
     if (!outside_unwidened(result.pose)) {
+      // Inside: the cost at the iterate has no bounds term whatever the border.
       normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2);
     } else {
+      // The robust normal equations, the plain information (the step's border) and the cost at
+      // the iterate under that border, in one pass.
       Eigen::Matrix4d plain_jtj;
       Eigen::Vector4d plain_jtr;
+      double huber_cost = 0.0;
       normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2, &plain_jtj,
-                       &plain_jtr);
-      const auto [radius, half_width] = border_of(plain_jtj);
+                       &plain_jtr, &huber_cost);
+      border = border_of(plain_jtj);
+      border_ready = true;
       Eigen::Matrix<double, 2, 3> jb;
-      const Eigen::Vector2d rb = BoundsResiduals(bounds, result.pose, radius, half_width, &jb);
+      const Eigen::Vector2d rb =
+          BoundsResiduals(bounds, result.pose, border.first, border.second, &jb);
       jtj.topLeftCorner<3, 3>() += jb.transpose() * jb;
       jtr.head<3>() += jb.transpose() * rb;
+      const double p = prior_weight * (result.focal_scale - 1.0);
+      cost = huber_cost + rb.squaredNorm() + p * p;
     }
     bool improved = false;
     Eigen::Vector4d step = Eigen::Vector4d::Zero();

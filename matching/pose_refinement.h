@@ -27,7 +27,8 @@ struct LineMatch {
 // The region a refined pose may not leave (docs/matching.md, section 6, fifth round): the disk
 // of radius radius_m + sigmas * position sigma around centre, and headings within half_width_rad
 // + sigmas * heading sigma of `heading`, the sigmas those of the image evidence at the pose
-// (PoseRefinementResult::position_sigma_m, heading_sigma_rad). Outside it the cost gains the
+// (PoseRefinementResult::position_sigma_m, heading_sigma_rad; RefinePose takes them at each step's
+// iterate and holds them during the step's trials). Outside it the cost gains the
 // one-sided residuals (d - R)_+ / softness_m and (|heading offset| - H)_+ / softness_rad: zero
 // inside, so a pose whose optimum lies inside is unchanged, and one that would slide out stops at
 // the border (within about softness^2 times the image cost's gradient).
