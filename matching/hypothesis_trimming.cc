@@ -13,6 +13,21 @@
 
 namespace linetrack {
 
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options) {
+  PoseRefinementOptions refinement = options.refinement;
+  if (context.prior == nullptr) return refinement;
+  const PriorRegion& prior = *context.prior;
+  refinement.bounds.active = true;
+  refinement.bounds.centre = prior.centre;
+  refinement.bounds.radius_m = prior.radius + options.prior_margin_m;
+  refinement.bounds.heading = prior.heading.Mid();
+  refinement.bounds.half_width_rad =
+      0.5 * prior.heading.Width() + DegToRad(options.prior_margin_deg);
+  refinement.bounds.sigmas = options.prior_margin_sigmas;
+  return refinement;
+}
+
 namespace {
 
 // The largest subset of the hypothesis' pairs that agrees with one minimal pose (two of its
@@ -89,7 +104,7 @@ PoseRefinementResult Refit(const VerificationContext& context, const Verificatio
                            double scale) {
   auto refine = [&] {
     return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                      start, scale, options.refinement);
+                      start, scale, RefinementOptions(context, options));
   };
   if (context.consensus_memo == nullptr) return refine();
   ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
@@ -168,7 +183,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
 int OutlyingPair(const VerificationContext& context, const VerificationOptions& options,
                  const VerifiedPose& hypothesis) {
   const std::vector<LineMatch> matches = ToLineMatches(context, hypothesis.pairs);
-  const Eigen::Matrix4d& c = hypothesis.refinement.covariance;
+  // The covariance of the cost minimised (with the prior's bounds where they hold the pose).
+  const Eigen::Matrix4d& c = hypothesis.refinement.bounded_covariance;
   int worst = -1;
   double worst_chi2 = options.gate_chi2;
   for (size_t i = 0; i < matches.size(); ++i) {
@@ -199,7 +215,7 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
       match.whitening * EndpointResiduals(match, *context.camera, context.height, context.tilt,
                                           verified.pose, verified.refinement.focal_scale, &j);
   const Eigen::Matrix<double, 2, 4> wj = match.whitening * j;
-  const Eigen::Matrix4d& c = verified.refinement.covariance;
+  const Eigen::Matrix4d& c = verified.refinement.bounded_covariance;
   const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
   if (!(complement.determinant() > 1e-6)) return false;
   // Sherman-Morrison-Woodbury on the normal equations (J = d residual / d pose, whitened):
@@ -239,8 +255,10 @@ PoseRefinementResult VouchedRefinement(const VerificationContext& context,
     }
   }
   if (kept.size() == matches.size()) return verified.refinement;
+  // Refitted under the same cost as the verification (the prior's bounds included), so the kept
+  // pairs cannot slide out of the prior; the result's covariance is the image information alone.
   return RefinePose(kept, *context.camera, context.height, context.tilt, verified.pose,
-                    verified.refinement.focal_scale, options.refinement);
+                    verified.refinement.focal_scale, RefinementOptions(context, options));
 }
 
 std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,

@@ -372,8 +372,9 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     result.reason = "ambiguous: another pose explains the image almost as well";
     return;
   }
-  // An unobservable pose inside the prior is a rival explanation too: when a distinct one comes
-  // within the margin, the accepted pose is not clearly the best explanation of the lines.
+  // An unobservable pose inside the prior (or one held at its border) is a rival explanation
+  // too: when a distinct one comes within the margin, the accepted pose is not clearly the best
+  // explanation of the lines.
   for (VerifiedPose& v : verified) {
     if (!v.unobservable || v.evidence.lines_nats < score - vo.ambiguity_nats ||
         SamePose(v.pose, best.pose, vo)) {
@@ -381,7 +382,11 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
     }
     CompleteEvidence(context, vo, &v);
     if (v.evidence.Score() > score - vo.ambiguity_nats) {
-      result.reason = "ambiguous: an unobservable pose explains the image almost as well";
+      result.reason = "ambiguous: " +
+                      std::string(v.implausible_because == "unobservable"
+                                      ? "an unobservable pose"
+                                      : "a pose held at the prior's border") +
+                      " explains the image almost as well";
       return;
     }
   }

@@ -24,6 +24,33 @@ struct LineMatch {
   Eigen::Matrix2d whitening = Eigen::Matrix2d::Identity();
 };
 
+// The region a refined pose may not leave (docs/matching.md, section 6, fifth round): the disk
+// of radius radius_m + sigmas * position sigma around centre, and headings within half_width_rad
+// + sigmas * heading sigma of `heading`, the sigmas those of the image evidence at the pose
+// (PoseRefinementResult::position_sigma_m, heading_sigma_rad; RefinePose takes them at each step's
+// iterate and holds them during the step's trials). Outside it the cost gains the
+// one-sided residuals (d - R)_+ / softness_m and (|heading offset| - H)_+ / softness_rad: zero
+// inside, so a pose whose optimum lies inside is unchanged, and one that would slide out stops at
+// the border (within about softness^2 times the image cost's gradient).
+struct PoseBounds {
+  bool active = false;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius_m = 0.0;
+  double heading = 0.0;  // middle of the heading interval (rad)
+  double half_width_rad = 0.0;
+  double sigmas = 0.0;
+  double softness_m = 1e-4;
+  double softness_rad = 1e-5;
+};
+
+// The two one-sided residuals of `bounds` at `pose` for the border radius_m (metres) and
+// half_width_rad (already widened by the pose's sigmas): ((d - radius_m)_+ / softness_m,
+// (|offset| - half_width_rad)_+ / softness_rad); `jacobian` (optional) gets d residual /
+// d (heading, x, y), the widening held fixed.
+Eigen::Vector2d BoundsResiduals(const PoseBounds& bounds, const Pose3Dof& pose, double radius_m,
+                                double half_width_rad,
+                                Eigen::Matrix<double, 2, 3>* jacobian = nullptr);
+
 struct PoseRefinementOptions {
   int max_iterations = 15;
   double step_tolerance = 1e-7;  // stop when the update (rad, m) is below this
@@ -33,6 +60,7 @@ struct PoseRefinementOptions {
   // min_matches_for_scale correspondences.
   double focal_prior_sigma = 0.0;
   int min_matches_for_scale = 2;
+  PoseBounds bounds;  // inactive by default
 
   bool Check(std::string* why) const;
 };
@@ -52,6 +80,16 @@ struct PoseRefinementResult {
   // standard deviation; infinite when the correspondences do not pin the pose down.
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
+  // With active bounds: how far the final pose lies outside them (metres, radians; 0 inside),
+  // and the covariance of the cost actually minimised (the image information plus the bounds'
+  // residuals', Gauss-Newton), the one the leave-one-out poses (DeletedPose, OutlyingPair) need.
+  // Equal to `covariance` when the pose is inside the bounds.
+  double bounds_excess_m = 0.0;
+  double bounds_excess_rad = 0.0;
+  Eigen::Matrix4d bounded_covariance = Eigen::Matrix4d::Zero();
+  // True when the bounds held the pose: it ended outside them by a hair, or inside but with the
+  // image evidence's Gauss-Newton step leading out of them.
+  bool held_by_bounds = false;
 };
 
 // The camera-from-world rotation of a robot pose, its derivative w.r.t. the heading and the
@@ -91,7 +129,8 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   Eigen::Matrix<double, 2, 4>* jacobian);
 
 // Refines `start` by Levenberg-Marquardt on all whitened endpoint residuals (Huber-weighted),
-// with the focal scale too when the options ask for it (starting from `start_scale`).
+// with the focal scale too when the options ask for it (starting from `start_scale`), and the
+// residuals of options.bounds when active.
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options);

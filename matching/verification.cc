@@ -101,12 +101,17 @@ bool InsidePrior(const VerificationContext& context, const Pose3Dof& pose,
   }
   if (context.prior == nullptr) return true;
   const PriorRegion& prior = *context.prior;
+  // The refinement holds a pose that would leave this region at its border (PoseBounds), outside
+  // it by about softness^2 times the image cost's gradient: within these it is on the border.
+  constexpr double kBorderToleranceM = 0.01;
+  constexpr double kBorderToleranceRad = 1e-3;
   const double k = options.prior_margin_sigmas;
   const double margin = DegToRad(options.prior_margin_deg) + k * refinement.heading_sigma_rad;
   const double offset = std::abs(WrapAngle(pose.heading - prior.heading.Mid()));
   return std::hypot(pose.x - prior.centre.x(), pose.y - prior.centre.y()) <=
-             prior.radius + options.prior_margin_m + k * refinement.position_sigma_m &&
-         offset <= 0.5 * prior.heading.Width() + margin;
+             prior.radius + options.prior_margin_m + k * refinement.position_sigma_m +
+                 kBorderToleranceM &&
+         offset <= 0.5 * prior.heading.Width() + margin + kBorderToleranceRad;
 }
 
 // The point of `edge` seen at the middle of the observed segment: the closest point of the edge
@@ -288,13 +293,18 @@ void Judge(const VerificationContext& context, const VerificationOptions& option
   const bool focal_ok =
       !(options.refinement.focal_prior_sigma > 0.0 &&
         std::abs(r.focal_scale - 1.0) > 4.0 * options.refinement.focal_prior_sigma);
+  // Held at the prior's border by the refinement (PoseBounds): the image evidence of its pairs
+  // puts the pose outside the prior, so the pose is the prior's rather than the lines' (a rival
+  // only).
+  const bool held = r.held_by_bounds;
   result->implausible_because = !enough_edges ? "too few edges"
                                 : !inside     ? "outside the prior"
                                 : !observable ? "unobservable"
+                                : held        ? "held at the prior's border"
                                 : !focal_ok   ? "focal scale"
                                               : "";
   result->plausible = result->implausible_because.empty();
-  result->unobservable = inside && !observable && focal_ok;
+  result->unobservable = inside && (!observable || held) && focal_ok;
 }
 
 }  // namespace
@@ -345,9 +355,10 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
   VerifiedPose result;
   result.pairs = pairs;
   const std::vector<LineMatch> matches = ToLineMatches(context, pairs);
+  const PoseRefinementOptions refinement = RefinementOptions(context, options);
   for (const Pose3Dof& start : starts) {
-    const PoseRefinementResult r = RefinePose(matches, *context.camera, context.height,
-                                              context.tilt, start, options.refinement);
+    const PoseRefinementResult r =
+        RefinePose(matches, *context.camera, context.height, context.tilt, start, refinement);
     if (result.refinement.iterations == 0 || r.chi2 < result.refinement.chi2) {
       result.refinement = r;
     }
@@ -423,7 +434,7 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
     if (pairs == previous || round == options.guided_rounds || pairs.size() < 2) break;
     result.refinement =
         RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                   result.pose, result.refinement.focal_scale, options.refinement);
+                   result.pose, result.refinement.focal_scale, RefinementOptions(context, options));
     result.pose = result.refinement.pose;
     previous = std::move(pairs);
   }

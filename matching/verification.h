@@ -161,7 +161,8 @@ struct VerifiedPose {
   bool evidence_complete = false;
   bool plausible = false;           // within the prior, enough edges, observable
   std::string implausible_because;  // the first check that failed (empty when plausible)
-  // Plausible but for its observability (position or heading sigma too large): a pose inside the
+  // Plausible but for its observability (position or heading sigma too large) or for being held
+  // at the prior's border by the refinement (its pairs alone put it outside): a pose inside the
   // prior that explains the lines but cannot be answered; still a rival of the accepted pose.
   bool unobservable = false;
 };

@@ -16,4 +16,9 @@ namespace linetrack {
 std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
                                      const std::vector<std::pair<int, int>>& pairs);
 
+// The verification's refinement options with the prior as bounds (PoseBounds): the prior disk
+// and heading interval widened by the options' margins, as the plausibility check widens them.
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options);
+
 }  // namespace linetrack
