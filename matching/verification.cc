@@ -517,17 +517,45 @@ double RequiredEvidence(const VerificationContext& context, const VerificationOp
   return options.chance_nats + std::max(0.0, std::log(prior_volume / pose_volume));
 }
 
+PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
+                             const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
+                             const std::pair<int, int>& pair) {
+  const auto [edge, line] = pair;
+  VerificationContext uncounted = context;  // not part of the search's work budget
+  uncounted.pair_tests = nullptr;
+  const std::vector<Candidate> fits =
+      Candidates(uncounted, ProjectEdges(context, pose, scale), pose, scale, covariance,
+                 FitModel(context, options));
+  PairExplanations out;
+  const auto own = std::find_if(fits.begin(), fits.end(), [&](const Candidate& c) {
+    return c.edge == edge && c.line == line;
+  });
+  if (own == fits.end()) return out;  // outside the gates at that pose
+  out.own = own->fit.log_likelihood_ratio;
+  const double overlap_tolerance = 3.0 * context.noise.offset_px;
+  const Segment2& piece = (*context.lines)[line].pixels;
+  for (const Candidate& c : fits) {
+    if (c.line == line && c.edge != edge) out.rivals.push_back(c.fit.log_likelihood_ratio);
+    if (c.edge != edge || c.line == line) continue;
+    const Segment2& other = (*context.lines)[c.line].pixels;
+    const bool longer = other.Length() > piece.Length();
+    const bool fragments = !Overlap(own->fit, c.fit, overlap_tolerance) &&
+                           FragmentChiSquare(longer ? other : piece, longer ? piece : other,
+                                             context.noise.fragment_offset_px) <= options.gate_chi2;
+    if (fragments) {
+      out.fragments = true;
+    } else {
+      out.rivals.push_back(c.fit.log_likelihood_ratio);
+    }
+  }
+  return out;
+}
+
 std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
                                                         const VerificationOptions& options,
                                                         const VerifiedPose& verified) {
-  const LineFitModel model = FitModel(context, options);
-  const double overlap_tolerance = 3.0 * context.noise.offset_px;
-  const double scale = verified.refinement.focal_scale;
-  VerificationContext uncounted = context;  // not part of the search's work budget
-  uncounted.pair_tests = nullptr;
   std::vector<std::pair<int, int>> reported;
   for (size_t i = 0; i < verified.pairs.size(); ++i) {
-    const auto [edge, line] = verified.pairs[i];
     if (!std::binary_search(verified.confident_pairs.begin(), verified.confident_pairs.end(),
                             verified.pairs[i])) {
       continue;
@@ -540,32 +568,17 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
       pose = verified.pose;
       covariance = verified.refinement.covariance;
     }
-    const std::vector<Candidate> fits =
-        Candidates(uncounted, ProjectEdges(context, pose, scale), pose, scale, covariance, model);
-    const auto own = std::find_if(fits.begin(), fits.end(), [&](const Candidate& c) {
-      return c.edge == edge && c.line == line;
-    });
-    if (own == fits.end()) continue;  // outside the gates at the pose of the others
+    const PairExplanations explained = ExplainPair(
+        context, options, pose, verified.refinement.focal_scale, covariance, verified.pairs[i]);
+    if (!std::isfinite(explained.own)) continue;  // outside the gates at the pose of the others
     // Other explanations at that pose: another edge for the line; another line for the edge
     // that would be its image instead (over the same stretch, or off the line of this one); and,
     // when the edge has other lines there (this one would be a further fragment beside them),
     // clutter: the line must stand without pulling the pose toward itself.
-    const Segment2& piece = (*context.lines)[line].pixels;
-    double rival = -std::numeric_limits<double>::infinity();
-    for (const Candidate& c : fits) {
-      if (c.line == line && c.edge != edge) rival = std::max(rival, c.fit.log_likelihood_ratio);
-      if (c.edge != edge || c.line == line) continue;
-      const Segment2& other = (*context.lines)[c.line].pixels;
-      const bool longer = other.Length() > piece.Length();
-      const bool fragments =
-          !Overlap(own->fit, c.fit, overlap_tolerance) &&
-          FragmentChiSquare(longer ? other : piece, longer ? piece : other,
-                            context.noise.fragment_offset_px) <= options.gate_chi2;
-      rival = std::max(rival, fragments ? 0.0 : c.fit.log_likelihood_ratio);
-    }
-    if (own->fit.log_likelihood_ratio - rival >= options.report_nats) {
-      reported.push_back(verified.pairs[i]);
-    }
+    double rival = explained.fragments ? 0.0 : -std::numeric_limits<double>::infinity();
+    for (const double r : explained.rivals)
+      rival = std::max(rival, r);
+    if (explained.own - rival >= options.report_nats) reported.push_back(verified.pairs[i]);
   }
   std::sort(reported.begin(), reported.end());
   return reported;

@@ -2,6 +2,7 @@
 // hypothesis_trimming.cc); not part of the matching library's interface.
 #pragma once
 
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -15,5 +16,18 @@ namespace linetrack {
 // (the projection is not known yet).
 std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
                                      const std::vector<std::pair<int, int>>& pairs);
+
+// The explanations of a pair's line at a pose (covariance of heading, x, y, scale; the context's
+// gates): the pair's log-likelihood ratio against clutter (nats; -infinity when outside the gates
+// there), those of its rival explanations (another edge for the line; another line for the edge
+// that cannot be a fragment of the same image), and whether the edge has such fragments there.
+struct PairExplanations {
+  double own = -std::numeric_limits<double>::infinity();
+  std::vector<double> rivals;
+  bool fragments = false;
+};
+PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
+                             const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
+                             const std::pair<int, int>& pair);
 
 }  // namespace linetrack
