@@ -139,11 +139,12 @@ struct Assignment {
 };
 
 // Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,
-// x, y, scale), the edge not hidden where the line lies.
+// x, y, scale), the edge not hidden where the line lies, and likelier than clutter (any finite
+// ratio when `any_ratio`).
 std::vector<Candidate> Candidates(const VerificationContext& context,
                                   const std::vector<EdgeImage>& images, const Pose3Dof& pose,
                                   double focal_scale, const Eigen::Matrix4d& pose_covariance,
-                                  const LineFitModel& model) {
+                                  const LineFitModel& model, bool any_ratio = false) {
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   const Eigen::Vector3d eye(pose.x, pose.y, context.height);
@@ -190,7 +191,10 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
       LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model,
                             end_variance[e]);
       fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
-      if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
+      if (!fit.gated ||
+          !(any_ratio ? std::isfinite(fit.log_likelihood_ratio) : fit.log_likelihood_ratio > 0.0)) {
+        continue;
+      }
       if (context.occlusion != nullptr &&
           context.occlusion->Blocked(
               eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
@@ -525,7 +529,7 @@ PairExplanations ExplainPair(const VerificationContext& context, const Verificat
   uncounted.pair_tests = nullptr;
   const std::vector<Candidate> fits =
       Candidates(uncounted, ProjectEdges(context, pose, scale), pose, scale, covariance,
-                 FitModel(context, options));
+                 FitModel(context, options), true);
   PairExplanations out;
   const auto own = std::find_if(fits.begin(), fits.end(), [&](const Candidate& c) {
     return c.edge == edge && c.line == line;
@@ -543,7 +547,7 @@ PairExplanations ExplainPair(const VerificationContext& context, const Verificat
                            FragmentChiSquare(longer ? other : piece, longer ? piece : other,
                                              context.noise.fragment_offset_px) <= options.gate_chi2;
     if (fragments) {
-      out.fragments = true;
+      out.fragments = out.fragments || c.fit.log_likelihood_ratio > 0.0;
     } else {
       out.rivals.push_back(c.fit.log_likelihood_ratio);
     }
@@ -570,14 +574,16 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
     }
     const PairExplanations explained = ExplainPair(
         context, options, pose, verified.refinement.focal_scale, covariance, verified.pairs[i]);
-    if (!std::isfinite(explained.own)) continue;  // outside the gates at the pose of the others
+    // Outside the gates at the pose of the others, or not likelier than clutter there.
+    if (!(explained.own > 0.0)) continue;
     // Other explanations at that pose: another edge for the line; another line for the edge
     // that would be its image instead (over the same stretch, or off the line of this one); and,
     // when the edge has other lines there (this one would be a further fragment beside them),
     // clutter: the line must stand without pulling the pose toward itself.
     double rival = explained.fragments ? 0.0 : -std::numeric_limits<double>::infinity();
-    for (const double r : explained.rivals)
-      rival = std::max(rival, r);
+    for (const double r : explained.rivals) {
+      if (r > 0.0) rival = std::max(rival, r);  // the rivals likelier than clutter
+    }
     if (explained.own - rival >= options.report_nats) reported.push_back(verified.pairs[i]);
   }
   std::sort(reported.begin(), reported.end());

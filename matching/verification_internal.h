@@ -18,9 +18,10 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
                                      const std::vector<std::pair<int, int>>& pairs);
 
 // The explanations of a pair's line at a pose (covariance of heading, x, y, scale; the context's
-// gates): the pair's log-likelihood ratio against clutter (nats; -infinity when outside the gates
-// there), those of its rival explanations (another edge for the line; another line for the edge
-// that cannot be a fragment of the same image), and whether the edge has such fragments there.
+// gates): the pair's log-likelihood ratio against clutter (nats, also when negative; -infinity
+// when outside the gates there), those of its rival explanations (another edge for the line;
+// another line for the edge that cannot be a fragment of the same image), and whether the edge
+// has such fragments there likelier than clutter.
 struct PairExplanations {
   double own = -std::numeric_limits<double>::infinity();
   std::vector<double> rivals;
