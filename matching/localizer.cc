@@ -391,9 +391,16 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
       vouched.refinement.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
   const VerifiedPose& base = observable ? vouched : best;
   // And it averages over what the unreported pairs it keeps are (true or clutter).
+  std::vector<DoubtedGroup> groups;
   const Eigen::Matrix4d covariance = vo.doubt_unreported_pairs
-                                         ? DoubtedCovariance(context, vo, base, reported)
+                                         ? DoubtedCovariance(context, vo, base, reported, &groups)
                                          : base.refinement.covariance;
+  for (const DoubtedGroup& group : groups) {
+    DoubtedMatches doubted{{}, group.probability_true};
+    for (const auto& [e, l] : group.pairs)
+      doubted.matches.emplace_back(edges[e].edge_id, l);
+    result.doubted.push_back(std::move(doubted));
+  }
   result.covariance = covariance.topLeftCorner<3, 3>();
   result.heading_sigma_rad = std::sqrt(covariance(0, 0));
   result.position_sigma_m =

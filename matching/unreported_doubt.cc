@@ -138,10 +138,17 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     pose.x += group.shift(1);
     pose.y += group.shift(2);
     const double scale = verified.refinement.focal_scale + group.shift(3);
+    // The lines and their uncertainty from the pose without the group (a line must not vouch
+    // for itself); which edges are in view, over which stretch and unhidden, from the pose where
+    // the pairs were found (a small shift must not push a seen edge out of the frame).
+    ExplainFrom from;
+    from.seen = &verified.pose;
+    from.seen_scale = verified.refinement.focal_scale;
+    from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
-      log_true +=
-          LogProbabilityTrue(ExplainPair(context, options, pose, scale, group.covariance, pair));
+      log_true += LogProbabilityTrue(
+          ExplainPair(context, options, pose, scale, group.covariance, pair, from));
     }
     group.probability_true = std::exp(log_true);
     const double doubt = 1.0 - group.probability_true;

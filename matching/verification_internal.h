@@ -21,14 +21,23 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
 // gates): the pair's log-likelihood ratio against clutter (nats, also when negative; -infinity
 // when outside the gates there), those of its rival explanations (another edge for the line;
 // another line for the edge that cannot be a fragment of the same image), and whether the edge
-// has such fragments there likelier than clutter.
+// has such fragments there likelier than clutter. `from` may move visibility, extent and
+// occlusion to another pose and give the pair's ratio beyond the gates.
 struct PairExplanations {
   double own = -std::numeric_limits<double>::infinity();
   std::vector<double> rivals;
   bool fragments = false;
 };
+struct ExplainFrom {
+  // When given: the pose (focal scale seen_scale) that decides the edges' visibility, extent
+  // (frustum clipping) and occlusion; the image lines and their uncertainty stay at `pose`.
+  const Pose3Dof* seen = nullptr;
+  double seen_scale = 1.0;
+  // The pair's own ratio also beyond the gates (across the line and on its extent).
+  bool beyond_gates = false;
+};
 PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
                              const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
-                             const std::pair<int, int>& pair);
+                             const std::pair<int, int>& pair, const ExplainFrom& from = {});
 
 }  // namespace linetrack

@@ -27,6 +27,8 @@ constexpr double kDeletedFloorDeg = 0.05;
 // The first-order covariance without a group agrees with the refit's within this share (standard
 // deviations of heading and of the position along x and y).
 constexpr double kDeletedSigmaShare = 0.15;
+// A true pair's posterior at or below this counts as lost (judged outside the frame or gates).
+constexpr double kLostTrueGroup = 0.0;
 
 class VerificationTest : public ::testing::Test {
  protected:
@@ -300,6 +302,40 @@ TEST_F(VerificationTest, DoubtedCovarianceWidensOnlyOverUnreportedPairs) {
       EXPECT_LE(group.probability_true, 1.0);
     }
   }
+}
+
+// The posterior of a true group is judged by the others' pose, but which edges are in view, over
+// which stretch, from the pose where the pairs were found: a small shift must not push a true
+// edge out of the frame or leave its line overhanging a projection clipped at the border (ninth
+// round: such pairs got p = 0 although true).
+TEST_F(VerificationTest, TrueGroupsKeepAPosteriorAtTheImageBorder) {
+  int groups = 0, lost = 0;
+  for (const uint64_t seed : {31, 32, 33, 34, 35, 36}) {
+    for (const SyntheticScene& scene : Scenes(seed, false)) {
+      const VerificationContext context = Context(scene);
+      // The pairs guided matching finds from the truth's pairs (as an answer's interpretation).
+      const VerifiedPose found =
+          VerifyHypothesis(context, scene.matches, {scene.truth.Planar()}, options_);
+      std::vector<DoubtedGroup> doubted;
+      DoubtedCovariance(context, options_, found, {}, &doubted);
+      for (const DoubtedGroup& group : doubted) {
+        const bool true_group =
+            std::all_of(group.pairs.begin(), group.pairs.end(), [&](const auto& pair) {
+              return std::find(scene.matches.begin(), scene.matches.end(), pair) !=
+                     scene.matches.end();
+            });
+        if (!true_group) continue;
+        ++groups;
+        if (group.probability_true <= kLostTrueGroup) {
+          ++lost;
+          ADD_FAILURE() << "seed " << seed << " scene " << scene.index << " edge "
+                        << group.pairs.front().first << ": p " << group.probability_true;
+        }
+      }
+    }
+  }
+  EXPECT_GT(groups, 100);
+  EXPECT_EQ(lost, 0);
 }
 
 }  // namespace
