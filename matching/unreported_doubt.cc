@@ -145,6 +145,8 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     from.seen = &verified.pose;
     from.seen_scale = verified.refinement.focal_scale;
     from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
+    // A rival line held by another edge of the interpretation is that pair undone, not free.
+    from.held = &verified.pairs;
     // Every pair of the group at the pose without all of it: twin false lines on one edge must
     // not vouch for each other (the chain rule was measured: docs/matching.md, ninth round).
     double log_true = 0.0;

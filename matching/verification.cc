@@ -591,7 +591,15 @@ PairExplanations ExplainPair(const VerificationContext& context, const Verificat
     if (fragments_of_one(*own, c)) {
       out.fragments = out.fragments || c.fit.log_likelihood_ratio > 0.0;
     } else {
-      out.rivals.push_back(c.fit.log_likelihood_ratio);
+      double displaced = 0.0;  // the ratio of the pair that holds the rival line, if any
+      if (from.held != nullptr) {
+        for (const auto& [e, l] : *from.held) {
+          if (l != c.line || e == edge) continue;
+          const auto holder = fit_of(e, l);
+          if (holder != fits.end()) displaced += holder->fit.log_likelihood_ratio;
+        }
+      }
+      out.rivals.push_back(c.fit.log_likelihood_ratio - displaced);
     }
   }
   return out;

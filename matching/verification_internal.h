@@ -22,7 +22,8 @@ std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
 // when outside the gates there), those of its rival explanations (another edge for the line;
 // another line for the edge that cannot be a fragment of the same image), and whether the edge
 // has such fragments there likelier than clutter. `from` may move visibility, extent and
-// occlusion to another pose and give the pair's ratio beyond the gates.
+// occlusion to another pose, give the pair's ratio beyond the gates, and price rival lines that
+// other pairs hold.
 struct PairExplanations {
   double own = -std::numeric_limits<double>::infinity();
   std::vector<double> rivals;
@@ -35,6 +36,9 @@ struct ExplainFrom {
   double seen_scale = 1.0;
   // The pair's own ratio also beyond the gates (across the line and on its extent).
   bool beyond_gates = false;
+  // When given: the interpretation's pairs (edge, line). A rival line that another edge holds
+  // there would undo that pair (a line is one edge's image at most): its ratio minus the holder's.
+  const std::vector<std::pair<int, int>>* held = nullptr;
 };
 PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
                              const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
