@@ -233,13 +233,16 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
 PoseRefinementResult VouchedRefinement(const VerificationContext& context,
                                        const VerificationOptions& options,
                                        const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported) {
+                                       const std::vector<std::pair<int, int>>& reported,
+                                       std::vector<std::pair<int, int>>* kept_pairs) {
   const std::vector<LineMatch> matches = ToLineMatches(context, verified.pairs);
   const Eigen::Matrix4d& c = verified.refinement.covariance;
   std::vector<LineMatch> kept;
+  if (kept_pairs != nullptr) kept_pairs->clear();
   for (size_t i = 0; i < matches.size(); ++i) {
     if (std::find(reported.begin(), reported.end(), verified.pairs[i]) != reported.end()) {
       kept.push_back(matches[i]);
+      if (kept_pairs != nullptr) kept_pairs->push_back(verified.pairs[i]);
       continue;
     }
     Eigen::Matrix<double, 2, 4> j;
@@ -252,6 +255,7 @@ PoseRefinementResult VouchedRefinement(const VerificationContext& context,
             .eigenvalues()
             .maxCoeff() < options.max_unreported_leverage) {
       kept.push_back(matches[i]);
+      if (kept_pairs != nullptr) kept_pairs->push_back(verified.pairs[i]);
     }
   }
   if (kept.size() == matches.size()) return verified.refinement;

@@ -7,6 +7,9 @@
 #include <numeric>
 #include <set>
 
+#include <Eigen/Eigenvalues>
+
+#include "matching/unreported_doubt.h"
 #include "models/errors.h"
 
 namespace linetrack {
@@ -411,13 +414,30 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   result.cam_from_world = CamFromWorld(result.pose);
   // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
   // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
-  const PoseRefinementResult vouched = VouchedRefinement(context, vo, best, reported);
-  const bool observable = vouched.position_sigma_m <= vo.max_position_sigma_m &&
-                          vouched.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
-  const PoseRefinementResult& uncertainty = observable ? vouched : best.refinement;
-  result.covariance = uncertainty.covariance.topLeftCorner<3, 3>();
-  result.position_sigma_m = uncertainty.position_sigma_m;
-  result.heading_sigma_rad = uncertainty.heading_sigma_rad;
+  VerifiedPose vouched = best;
+  vouched.refinement = VouchedRefinement(context, vo, best, reported, &vouched.pairs);
+  vouched.pose = vouched.refinement.pose;
+  const bool observable =
+      vouched.refinement.position_sigma_m <= vo.max_position_sigma_m &&
+      vouched.refinement.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
+  const VerifiedPose& base = observable ? vouched : best;
+  // And it averages over what the unreported pairs it keeps are (true or clutter).
+  std::vector<DoubtedGroup> groups;
+  const Eigen::Matrix4d covariance = vo.doubt_unreported_pairs
+                                         ? DoubtedCovariance(context, vo, base, reported, &groups)
+                                         : base.refinement.covariance;
+  for (const DoubtedGroup& group : groups) {
+    DoubtedMatches doubted{{}, group.probability_true};
+    for (const auto& [e, l] : group.pairs)
+      doubted.matches.emplace_back(edges[e].edge_id, l);
+    result.doubted.push_back(std::move(doubted));
+  }
+  result.covariance = covariance.topLeftCorner<3, 3>();
+  result.heading_sigma_rad = std::sqrt(covariance(0, 0));
+  result.position_sigma_m =
+      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+                                  covariance.block<2, 2>(1, 1), Eigen::EigenvaluesOnly)
+                                  .eigenvalues()[1]));
   for (const auto& [e, l] : reported)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());

@@ -67,6 +67,12 @@ struct Finalist {
   std::vector<std::pair<int, int>> matches;  // (model edge id, line index)
 };
 
+// Unreported pairs of one model edge that the answer's covariance doubts, for diagnostics.
+struct DoubtedMatches {
+  std::vector<std::pair<int, int>> matches;  // (model edge id, line index)
+  double probability_true = 1.0;             // posterior that all are the edge's image
+};
+
 struct LocalizationResult {
   bool found = false;
   RobotPose pose;                                                    // valid when found
@@ -95,6 +101,8 @@ struct LocalizationResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
+  // The doubted groups behind `covariance` (docs/matching.md, ninth round).
+  std::vector<DoubtedMatches> doubted;
 };
 
 class Localizer {

@@ -70,19 +70,25 @@ Eigen::Matrix<double, 2, 4> ProjectionJacobian(const CameraIntrinsics& camera, c
   return j;
 }
 
-std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
-                                    double focal_scale) {
+// The edges' images at `pose` over the stretches of them inside the frustum of `seen` (which
+// decides visibility and extent; `pose` the position of the image lines).
+std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
+                                            const Pose3Dof& pose, double focal_scale,
+                                            const Pose3Dof& seen, double seen_scale) {
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  const CameraIntrinsics seen_camera = ScaledCamera(*context.camera, seen_scale);
+  const Eigen::Isometry3d seen_from_world = CamFromWorld(Full(seen, context));
   const PoseView view = ViewOf(pose, context.height, context.tilt);
   std::vector<EdgeImage> out(context.edges->size());
   for (size_t e = 0; e < out.size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
     EdgeImage& image = out[e];
     image.world = {edge.a, edge.b};
-    if (!ClipToFrustum(cam_from_world, camera, 0.05, &image.world)) continue;
-    image.image = {camera.Project(cam_from_world * image.world.a),
-                   camera.Project(cam_from_world * image.world.b)};
+    if (!ClipToFrustum(seen_from_world, seen_camera, 0.05, &image.world)) continue;
+    const Eigen::Vector3d a = cam_from_world * image.world.a, b = cam_from_world * image.world.b;
+    if (!(a.z() > 0.05 && b.z() > 0.05)) continue;  // behind the camera at `pose`
+    image.image = {camera.Project(a), camera.Project(b)};
     if (image.image.Length() < 1e-6) continue;
     image.visible = true;
     image.line =
@@ -91,6 +97,11 @@ std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Po
     image.d_end = ProjectionJacobian(*context.camera, view, focal_scale, image.world.b);
   }
   return out;
+}
+
+std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
+                                    double focal_scale) {
+  return ProjectEdgesSeenFrom(context, pose, focal_scale, pose, focal_scale);
 }
 
 bool InsidePrior(const VerificationContext& context, const Pose3Dof& pose,
@@ -144,14 +155,18 @@ struct Assignment {
 };
 
 // Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,
-// x, y, scale), the edge not hidden where the line lies.
+// x, y, scale), the edge not hidden where the line lies (seen from `seen` when given, of focal
+// scale `seen_scale`), and likelier than clutter (any finite ratio when `any_ratio`).
 std::vector<Candidate> Candidates(const VerificationContext& context,
                                   const std::vector<EdgeImage>& images, const Pose3Dof& pose,
                                   double focal_scale, const Eigen::Matrix4d& pose_covariance,
-                                  const LineFitModel& model) {
-  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
-  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
-  const Eigen::Vector3d eye(pose.x, pose.y, context.height);
+                                  const LineFitModel& model, bool any_ratio = false,
+                                  const Pose3Dof* seen = nullptr, double seen_scale = 1.0) {
+  const Pose3Dof& viewpoint = seen != nullptr ? *seen : pose;
+  const CameraIntrinsics camera =
+      ScaledCamera(*context.camera, seen != nullptr ? seen_scale : focal_scale);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(viewpoint, context));
+  const Eigen::Vector3d eye(viewpoint.x, viewpoint.y, context.height);
   std::vector<Candidate> out;
   if (context.pair_tests != nullptr) {
     const long visible = std::count_if(images.begin(), images.end(),
@@ -195,7 +210,10 @@ std::vector<Candidate> Candidates(const VerificationContext& context,
       LineFit fit = FitLine(image.image, observed, j * pose_covariance * j.transpose(), model,
                             end_variance[e]);
       fit.log_likelihood_ratio -= (*context.lines)[l].clutter_log_density;
-      if (!fit.gated || !(fit.log_likelihood_ratio > 0.0)) continue;
+      if (!fit.gated ||
+          !(any_ratio ? std::isfinite(fit.log_likelihood_ratio) : fit.log_likelihood_ratio > 0.0)) {
+        continue;
+      }
       if (context.occlusion != nullptr &&
           context.occlusion->Blocked(
               eye, PointSeenOnEdge((*context.edges)[e], observed, cam_from_world, eye, camera))) {
@@ -528,17 +546,81 @@ double RequiredEvidence(const VerificationContext& context, const VerificationOp
   return options.chance_nats + std::max(0.0, std::log(prior_volume / pose_volume));
 }
 
+PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
+                             const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
+                             const std::pair<int, int>& pair, const ExplainFrom& from) {
+  const auto [edge, line] = pair;
+  VerificationContext uncounted = context;  // not part of the search's work budget
+  uncounted.pair_tests = nullptr;
+  const std::vector<EdgeImage> images =
+      from.seen != nullptr ? ProjectEdgesSeenFrom(context, pose, scale, *from.seen, from.seen_scale)
+                           : ProjectEdges(context, pose, scale);
+  const std::vector<Candidate> fits =
+      Candidates(uncounted, images, pose, scale, covariance, FitModel(context, options), true,
+                 from.seen, from.seen_scale);
+  PairExplanations out;
+  auto fit_of = [&](int e, int l) {
+    return std::find_if(fits.begin(), fits.end(),
+                        [&](const Candidate& c) { return c.edge == e && c.line == l; });
+  };
+  const auto found = fit_of(edge, line);
+  const Candidate* own = found != fits.end() ? &*found : nullptr;
+  std::vector<Candidate> beyond;
+  if (own == nullptr && from.beyond_gates) {
+    // Its ratio all the same (the gates only save work): the line alone against every edge.
+    LineFitModel ungated = FitModel(context, options);
+    ungated.gate_chi2 = ungated.extent_sigmas = std::numeric_limits<double>::infinity();
+    const std::vector<ObservedLine> alone = {(*context.lines)[line]};
+    VerificationContext single = uncounted;
+    single.lines = &alone;
+    single.excluded_pair = {-1, -1};
+    for (Candidate& c : Candidates(single, images, pose, scale, covariance, ungated, true,
+                                   from.seen, from.seen_scale)) {
+      if (c.edge != edge) continue;
+      c.line = line;  // its index among all lines
+      beyond.push_back(c);
+    }
+    if (!beyond.empty()) own = &beyond.front();
+  }
+  if (own == nullptr) return out;  // not in view, or hidden, at that pose
+  out.own = own->fit.log_likelihood_ratio;
+  const double overlap_tolerance = 3.0 * context.noise.offset_px;
+  // Two lines can both be images of one edge: fragments that do not overlap, on one line.
+  auto fragments_of_one = [&](const Candidate& a, const Candidate& b) {
+    const Segment2& pa = (*context.lines)[a.line].pixels;
+    const Segment2& pb = (*context.lines)[b.line].pixels;
+    const bool longer = pa.Length() > pb.Length();
+    return !Overlap(a.fit, b.fit, overlap_tolerance) &&
+           FragmentChiSquare(longer ? pa : pb, longer ? pb : pa,
+                             context.noise.fragment_offset_px) <= options.gate_chi2;
+  };
+  for (const Candidate& c : fits) {
+    if (c.line == line && c.edge != edge) {
+      out.rivals.push_back(c.fit.log_likelihood_ratio);
+    }
+    if (c.edge != edge || c.line == line) continue;
+    if (fragments_of_one(*own, c)) {
+      out.fragments = out.fragments || c.fit.log_likelihood_ratio > 0.0;
+    } else {
+      double displaced = 0.0;  // the ratio of the pair that holds the rival line, if any
+      if (from.held != nullptr) {
+        for (const auto& [e, l] : *from.held) {
+          if (l != c.line || e == edge) continue;
+          const auto holder = fit_of(e, l);
+          if (holder != fits.end()) displaced += holder->fit.log_likelihood_ratio;
+        }
+      }
+      out.rivals.push_back(c.fit.log_likelihood_ratio - displaced);
+    }
+  }
+  return out;
+}
+
 std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
                                                         const VerificationOptions& options,
                                                         const VerifiedPose& verified) {
-  const LineFitModel model = FitModel(context, options);
-  const double overlap_tolerance = 3.0 * context.noise.offset_px;
-  const double scale = verified.refinement.focal_scale;
-  VerificationContext uncounted = context;  // not part of the search's work budget
-  uncounted.pair_tests = nullptr;
   std::vector<std::pair<int, int>> reported;
   for (size_t i = 0; i < verified.pairs.size(); ++i) {
-    const auto [edge, line] = verified.pairs[i];
     if (!std::binary_search(verified.confident_pairs.begin(), verified.confident_pairs.end(),
                             verified.pairs[i])) {
       continue;
@@ -551,32 +633,19 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
       pose = verified.pose;
       covariance = verified.refinement.covariance;
     }
-    const std::vector<Candidate> fits =
-        Candidates(uncounted, ProjectEdges(context, pose, scale), pose, scale, covariance, model);
-    const auto own = std::find_if(fits.begin(), fits.end(), [&](const Candidate& c) {
-      return c.edge == edge && c.line == line;
-    });
-    if (own == fits.end()) continue;  // outside the gates at the pose of the others
+    const PairExplanations explained = ExplainPair(
+        context, options, pose, verified.refinement.focal_scale, covariance, verified.pairs[i]);
+    // Outside the gates at the pose of the others, or not likelier than clutter there.
+    if (!(explained.own > 0.0)) continue;
     // Other explanations at that pose: another edge for the line; another line for the edge
     // that would be its image instead (over the same stretch, or off the line of this one); and,
     // when the edge has other lines there (this one would be a further fragment beside them),
     // clutter: the line must stand without pulling the pose toward itself.
-    const Segment2& piece = (*context.lines)[line].pixels;
-    double rival = -std::numeric_limits<double>::infinity();
-    for (const Candidate& c : fits) {
-      if (c.line == line && c.edge != edge) rival = std::max(rival, c.fit.log_likelihood_ratio);
-      if (c.edge != edge || c.line == line) continue;
-      const Segment2& other = (*context.lines)[c.line].pixels;
-      const bool longer = other.Length() > piece.Length();
-      const bool fragments =
-          !Overlap(own->fit, c.fit, overlap_tolerance) &&
-          FragmentChiSquare(longer ? other : piece, longer ? piece : other,
-                            context.noise.fragment_offset_px) <= options.gate_chi2;
-      rival = std::max(rival, fragments ? 0.0 : c.fit.log_likelihood_ratio);
+    double rival = explained.fragments ? 0.0 : -std::numeric_limits<double>::infinity();
+    for (const double r : explained.rivals) {
+      if (r > 0.0) rival = std::max(rival, r);  // the rivals likelier than clutter
     }
-    if (own->fit.log_likelihood_ratio - rival >= options.report_nats) {
-      reported.push_back(verified.pairs[i]);
-    }
+    if (explained.own - rival >= options.report_nats) reported.push_back(verified.pairs[i]);
   }
   std::sort(reported.begin(), reported.end());
   return reported;

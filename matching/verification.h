@@ -73,6 +73,10 @@ struct VerificationOptions {
   // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
   // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching.md section 6).
   double max_unreported_leverage = 0.75;
+  // The accepted pose's covariance then also averages over what its unreported pairs are: each
+  // edge's unreported pairs are false with their posterior probability, and the pose is then
+  // the pose without them (law of total covariance, DoubtedCovariance in unreported_doubt.h).
+  bool doubt_unreported_pairs = true;
   // A pose may leave the prior disk by prior_margin_m plus prior_margin_sigmas of its position
   // standard deviation, and the heading interval likewise.
   double prior_margin_m = 0.05;
@@ -238,11 +242,13 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
 // W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
 // high-leverage unreported pairs left out at once); its own refinement when none is left out. An
 // unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
-// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107).
+// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107). `kept`,
+// when given, receives the pairs of the refinement.
 PoseRefinementResult VouchedRefinement(const VerificationContext& context,
                                        const VerificationOptions& options,
                                        const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported);
+                                       const std::vector<std::pair<int, int>>& reported,
+                                       std::vector<std::pair<int, int>>* kept = nullptr);
 
 // The poses a verified pose's pairs give without one of its influential pairs (the first-order
 // deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the

@@ -205,6 +205,62 @@ nlohmann::ordered_json BudgetJson(const SyntheticScene& scene, const Localizatio
           {"series", series}};
 }
 
+// Calibration of the doubted groups' posterior against the scenes' truth (a group is true when
+// all its pairs are): per bin of p, the groups and how many are true.
+struct DoubtCalibration {
+  static constexpr double kEdges[] = {0.0, 1e-9, 0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999};
+  static constexpr int kBins = 10;
+  int groups[kBins] = {}, true_groups[kBins] = {};
+  double sum_p[kBins] = {};
+  double summed_doubt = 0.0;
+  int loose_correct = 0;  // correct answers whose sigmas exceed the observability limits
+
+  void Add(const SyntheticScene& scene, const LocalizationResult& result, Outcome outcome,
+           const VerificationOptions& limits) {
+    if (outcome == Outcome::kCorrect &&
+        (result.position_sigma_m > limits.max_position_sigma_m ||
+         result.heading_sigma_rad > DegToRad(limits.max_heading_sigma_deg))) {
+      ++loose_correct;
+    }
+    const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
+    for (const DoubtedMatches& g : result.doubted) {
+      const double p = g.probability_true;
+      int bin = kBins - 1;
+      while (bin > 0 && p < kEdges[bin])
+        --bin;
+      ++groups[bin];
+      sum_p[bin] += p;
+      summed_doubt += 1.0 - p;
+      const bool all_true = std::all_of(g.matches.begin(), g.matches.end(),
+                                        [&](const auto& m) { return truth.count(m) > 0; });
+      true_groups[bin] += all_true ? 1 : 0;
+    }
+  }
+
+  std::string Table() const {
+    std::ostringstream out;
+    int total = 0, false_groups = 0;
+    out << "\nPosterior of the doubted unreported groups against the truth (all series):\n\n"
+        << "| p_G | groups | share true | mean p_G |\n| --- | --- | --- | --- |\n";
+    for (int b = 0; b < kBins; ++b) {
+      total += groups[b];
+      false_groups += groups[b] - true_groups[b];
+      const std::string range =
+          b == 0 ? "0"
+                 : (b + 1 < kBins ? std::to_string(kEdges[b]).substr(0, 5) + "-" +
+                                        std::to_string(kEdges[b + 1]).substr(0, 5)
+                                  : ">= 0.999");
+      out << std::fixed << "| " << range << " | " << groups[b] << " | " << std::setprecision(3)
+          << (groups[b] > 0 ? static_cast<double>(true_groups[b]) / groups[b] : 0.0) << " | "
+          << (groups[b] > 0 ? sum_p[b] / groups[b] : 0.0) << " |\n";
+    }
+    out << "\nGroups " << total << ", false " << false_groups << ", summed doubt "
+        << std::setprecision(1) << summed_doubt << "; correct answers with sigmas beyond the "
+        << "observability limits: " << loose_correct << ".\n";
+    return out.str();
+  }
+};
+
 std::string Row(const std::string& matcher, const Tally& t) {
   std::ostringstream row;
   const double n = std::max(1, t.Total());
@@ -241,6 +297,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
            "correct answers (median) |\n"
         << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   std::ostringstream beyond;  // correct answers accurate only by their own confidence region
+  DoubtCalibration calibration;
   for (const Series& s : series) {
     SyntheticSceneOptions scene_options;
     scene_options.seed = opt.seed;
@@ -274,6 +331,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
         const Outcome outcome = Score(scene, result, ms, m == 0 ? &tree_tally : &baseline_tally);
+        if (m == 0) calibration.Add(scene, result, outcome, tree_options.verification);
         if (m == 0 && diagnosis && outcome != Outcome::kCorrect) {
           const TruthDiagnosis d =
               DiagnoseTruth(tree, problem, scene.truth.Planar(), scene.matches);
@@ -309,6 +367,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
         << " deg of the truth, or the truth inside the answer's own 99.9 % confidence region "
            "(its covariance). Correct by that region only (farther than the tolerance): "
         << beyond.str() << ".\n";
+  table << calibration.Table();
   std::cout << table.str();
   if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, table.str());
   if (diagnosis) WriteFileAtomically(opt.diagnose_path, diagnosis->str());
