@@ -1,16 +1,68 @@
-// Pieces of the verification shared by its two source files (verification.cc and
-// hypothesis_trimming.cc); not part of the matching library's interface.
+// Pieces of the verification shared by its source files (verification.cc, edge_candidates.cc,
+// hypothesis_trimming.cc, unreported_doubt.cc); not part of the matching library's interface.
 #pragma once
 
 #include <limits>
 #include <utility>
 #include <vector>
 
+#include "matching/line_fit.h"
 #include "matching/pose_refinement.h"
 #include "matching/quantiles.h"
 #include "matching/verification.h"
+#include "models/robot_pose.h"
 
 namespace linetrack {
+
+// The full robot pose (known height and tilt) of a 3-DOF pose.
+RobotPose Full(const Pose3Dof& pose, const VerificationContext& context);
+
+// The camera with its focal lengths scaled by `scale` (the estimated calibration error).
+CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale);
+
+// A candidate edge seen from the pose: its frustum-clipped image, the clipped world segment, and
+// its image line with the derivative w.r.t. (heading, x, y, scale).
+struct EdgeImage {
+  bool visible = false;
+  Segment2 image;
+  Segment3 world;
+  Eigen::Vector3d line;
+  Eigen::Matrix<double, 3, 4> d_line;
+  // d image.a / d (heading, x, y, scale) and the same for image.b.
+  Eigen::Matrix<double, 2, 4> d_start, d_end;
+
+  // Variances along the image of its two ends for the pose covariance `c`.
+  Eigen::Vector2d EndVariance(const Eigen::Matrix4d& c) const {
+    const Eigen::Vector2d u = (image.b - image.a).normalized();
+    const Eigen::Vector4d ja = d_start.transpose() * u, jb = d_end.transpose() * u;
+    return {ja.dot(c * ja), jb.dot(c * jb)};
+  }
+};
+
+// The edges' images at `pose` over the stretches of them inside the frustum of `seen` (which
+// decides visibility and extent; `pose` the position of the image lines).
+std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
+                                            const Pose3Dof& pose, double focal_scale,
+                                            const Pose3Dof& seen, double seen_scale);
+// The edges' images at `pose`, seen from it.
+std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
+                                    double focal_scale);
+
+// A line that fits an edge within the gates at the pose.
+struct Candidate {
+  int edge = -1;
+  int line = -1;
+  LineFit fit;
+};
+
+// Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,
+// x, y, scale), the edge not hidden where the line lies (seen from `seen` when given, of focal
+// scale `seen_scale`), and likelier than clutter (any finite ratio when `any_ratio`).
+std::vector<Candidate> Candidates(const VerificationContext& context,
+                                  const std::vector<EdgeImage>& images, const Pose3Dof& pose,
+                                  double focal_scale, const Eigen::Matrix4d& pose_covariance,
+                                  const LineFitModel& model, bool any_ratio = false,
+                                  const Pose3Dof* seen = nullptr, double seen_scale = 1.0);
 
 // Pairs as LineMatches whitened by the noise model with levers from the segment's own middle
 // (the projection is not known yet).

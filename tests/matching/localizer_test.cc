@@ -418,13 +418,20 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
   EXPECT_GT(leaves_seen, 0);
 }
 
-// Seed 1 wide scene 414 (ninth round): the budget ran out in the root's first branch (line 12 on
-// edge 36, a wrong pair) at 5 000 nodes; the truth (121 nats) is in the branch giving line 12 to
-// edge 49, never reached, and a pose 0.94 m / 5.9 deg off (55 nats, two unreported false pairs)
-// was answered. The unsearched root branches find the truth.
+// Seed 5 wide scene 395 (ninth round): the budget runs out in the root's first branch (edge 54's)
+// while the truth is in a sibling (edge 61's) of the same bound. Without the unsearched root
+// branches a pose 0.96 m / 7.8 deg off (two unreported false pairs) is answered; with them, the
+// truth. (The round's first case, seed 1 wide 414, no longer exhausts its budget since the prior's
+// bounds entered the refinement.)
 TEST_F(LocalizerTest, TruthInAnUnsearchedRootBranchIsFound) {
   SyntheticScene scene;
-  const LocalizationResult r = LocalizeBenchmarkScene(1, 2.0, 45.0, 414, &scene);
+  LocalizerOptions without;
+  without.unsearched_branches_share = 0.0;
+  const LocalizationResult before = LocalizeBenchmarkScene(5, 2.0, 45.0, 395, &scene, without);
+  ASSERT_TRUE(before.found) << before.reason;  // the scene exercises the mechanism
+  EXPECT_GT(std::hypot(before.pose.x - scene.truth.x, before.pose.y - scene.truth.y),
+            kWrongPositionM);
+  const LocalizationResult r = LocalizeBenchmarkScene(5, 2.0, 45.0, 395, &scene);
   ASSERT_TRUE(r.found) << r.reason;
   EXPECT_TRUE(r.budget_exhausted);
   EXPECT_LE(std::hypot(r.pose.x - scene.truth.x, r.pose.y - scene.truth.y), kWrongPositionM);
