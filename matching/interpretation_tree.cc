@@ -383,7 +383,7 @@ class TreeSearch {
     // A leaf consistent with a verified pose would be verified into it again: its region holds
     // the pose and it assigns no line otherwise than the pose does (a line fitting the pose with
     // another edge). A leaf giving a line to another edge is another interpretation, however wide
-    // its region (3-sigma gates) is: verified (docs/matching.md, section 6, fourth round).
+    // its region (3-sigma gates) is: verified (docs/matching-rounds.md, fourth round).
     if (basins_ != nullptr &&
         std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
           return !AssignsLineOtherwise(assigned_, b.fitting) && region.Contains(b.pose);

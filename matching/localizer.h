@@ -88,7 +88,7 @@ struct LocalizationResult {
   int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
   // The main tree search's InterpretationTreeStats::completed_bound (nats): leaves it did not
-  // visit have a bound below it when the budget ran out (docs/matching.md, eighth round).
+  // visit have a bound below it when the budget ran out (docs/matching-rounds.md, eighth round).
   double tree_completed_bound = 0.0;
   // The largest completed_bound of the searches over unexplained lines (0 when none ran).
   double unexplained_completed_bound = 0.0;
@@ -101,7 +101,7 @@ struct LocalizationResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
-  // The doubted groups behind `covariance` (docs/matching.md, ninth round).
+  // The doubted groups behind `covariance` (docs/matching-rounds.md, ninth round).
   std::vector<DoubtedMatches> doubted;
 };
 

@@ -24,7 +24,7 @@ struct LineMatch {
   Eigen::Matrix2d whitening = Eigen::Matrix2d::Identity();
 };
 
-// The region a refined pose may not leave (docs/matching.md, section 6, fifth round): the disk
+// The region a refined pose may not leave (docs/matching-rounds.md, fifth round): the disk
 // of radius radius_m + sigmas * position sigma around centre, and headings within half_width_rad
 // + sigmas * heading sigma of `heading`, the sigmas those of the image evidence at the pose
 // (PoseRefinementResult::position_sigma_m, heading_sigma_rad; RefinePose takes them at each step's

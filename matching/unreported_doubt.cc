@@ -148,7 +148,7 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     // A rival line held by another edge of the interpretation is that pair undone, not free.
     from.held = &verified.pairs;
     // Every pair of the group at the pose without all of it: twin false lines on one edge must
-    // not vouch for each other (the chain rule was measured: docs/matching.md, ninth round).
+    // not vouch for each other (the chain rule was measured: docs/matching-rounds.md, ninth round).
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
       log_true += LogProbabilityTrue(

@@ -61,7 +61,7 @@ struct VerificationOptions {
   // benchmark seed) the accepted true poses reached 0.655 of their lines' caps in the median,
   // 0.847 at the 99th percentile, 0.891 at most; 0.7 cuts the subtrees that could only win with
   // better-than-typical lines, and the truth, searched first by iterative deepening, is rarely
-  // one of them (docs/matching.md, third round).
+  // one of them (docs/matching-rounds.md, third round).
   double cap_efficiency = 0.7;
   // Work budget of the verification (deterministic): (line, visible edge) pairs guided matching
   // may test over all hypotheses of one localisation; then no more hypotheses are verified.
@@ -71,7 +71,8 @@ struct VerificationOptions {
   double max_heading_sigma_deg = 5.0;
   // The accepted pose's covariance does not lean on an unreported pair whose leverage (largest
   // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
-  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching.md section 6).
+  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching-rounds.md, seventh
+  // round).
   double max_unreported_leverage = 0.75;
   // The accepted pose's covariance then also averages over what its unreported pairs are: each
   // edge's unreported pairs are false with their posterior probability, and the pose is then

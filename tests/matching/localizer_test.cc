@@ -205,7 +205,7 @@ TEST_F(LocalizerTest, MalformedProblemsAreRejected) {
   expect_error(p, "prior x");
 }
 
-// The fourth round's wrong poses (docs/matching.md, section 6, "Fourth round"): answered about
+// The fourth round's wrong poses (docs/matching-rounds.md, "Fourth round"): answered about
 // 1 m and 6 degrees from the truth before; now the truth's interpretation rivals them.
 // Scene 53: the truth's pairs give a pose whose position sigma (0.54 m) exceeds the 0.5 m limit;
 // it explains the lines with 56.7 nats, the accepted pose (a true line on a wrong edge) 17.7.
@@ -237,7 +237,7 @@ TEST_F(LocalizerTest, LeafAssigningLinesOtherwiseIsVerified) {
   EXPECT_TRUE(truth_is_finalist);
 }
 
-// The fifth round (docs/matching.md, section 6): seed 5 scene 409 was answered 1.05 m and 6.7
+// The fifth round (docs/matching-rounds.md): seed 5 scene 409 was answered 1.05 m and 6.7
 // degrees off at QI2 and QI3 (4 edges, 21.3 nats) because the truth's pairs, refined without the
 // prior, slid along their weakly observed direction 1.5 m out of it. Refined within the prior
 // (PoseBounds) they stop at its border, a pose held there (and at QI3 unobservable) that rivals
@@ -317,9 +317,10 @@ TEST(AssignsLineOtherwiseTest, OnlyALineOnAnotherEdgeContradicts) {
   EXPECT_FALSE(AssignsLineOtherwise({}, fitting));
 }
 
-// The tree's completed_bound (docs/matching.md, eighth round): when the budget stops the search,
-// every leaf whose bound reaches the last completed pass's bound was visited. Checked against the
-// complete search (unit caps: a leaf's bound is its number of lines) on seed 1 QI1 scene 0.
+// The tree's completed_bound (docs/matching-rounds.md, eighth round): when the budget stops the
+// search, every leaf whose bound reaches the last completed pass's bound was visited. Checked
+// against the complete search (unit caps: a leaf's bound is its number of lines) on seed 1 QI1
+// scene 0.
 TEST_F(LocalizerTest, LeavesAboveTheCompletedPassBoundAreVisitedWhenTheBudgetRunsOut) {
   const auto [edges, lines, prior] = BenchmarkTreeInput(1, 0.30, 10.0, 0);
   auto keys = [](const std::vector<Hypothesis>& leaves) {
