@@ -44,6 +44,21 @@ Eigen::Vector3d PointSeenOnEdge(const MatchEdge& edge, const Segment2& observed,
   return edge.a + t * d;
 }
 
+// The image of `edge` (world segment, pixels, visible) over its stretch inside the frustum of
+// the seen camera, placed by the camera at `cam_from_world`; false when not visible.
+bool ClippedImage(const MatchEdge& edge, const Eigen::Isometry3d& cam_from_world,
+                  const CameraIntrinsics& camera, const Eigen::Isometry3d& seen_from_world,
+                  const CameraIntrinsics& seen_camera, EdgeImage* image) {
+  image->world = {edge.a, edge.b};
+  if (!ClipToFrustum(seen_from_world, seen_camera, 0.05, &image->world)) return false;
+  const Eigen::Vector3d a = cam_from_world * image->world.a, b = cam_from_world * image->world.b;
+  if (!(a.z() > 0.05 && b.z() > 0.05)) return false;  // behind the camera at `pose`
+  image->image = {camera.Project(a), camera.Project(b)};
+  if (image->image.Length() < 1e-6) return false;
+  image->visible = true;
+  return true;
+}
+
 }  // namespace
 
 RobotPose Full(const Pose3Dof& pose, const VerificationContext& context) {
@@ -72,13 +87,7 @@ std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
   for (size_t e = 0; e < out.size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
     EdgeImage& image = out[e];
-    image.world = {edge.a, edge.b};
-    if (!ClipToFrustum(seen_from_world, seen_camera, 0.05, &image.world)) continue;
-    const Eigen::Vector3d a = cam_from_world * image.world.a, b = cam_from_world * image.world.b;
-    if (!(a.z() > 0.05 && b.z() > 0.05)) continue;  // behind the camera at `pose`
-    image.image = {camera.Project(a), camera.Project(b)};
-    if (image.image.Length() < 1e-6) continue;
-    image.visible = true;
+    if (!ClippedImage(edge, cam_from_world, camera, seen_from_world, seen_camera, &image)) continue;
     image.line =
         ProjectedEdgeLine(edge.a, edge.b, *context.camera, view, focal_scale, &image.d_line);
     image.d_start = ProjectionJacobian(*context.camera, view, focal_scale, image.world.a);
@@ -90,6 +99,20 @@ std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
 std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
                                     double focal_scale) {
   return ProjectEdgesSeenFrom(context, pose, focal_scale, pose, focal_scale);
+}
+
+std::vector<EdgeImage> ProjectPairedEdges(const VerificationContext& context, const Pose3Dof& pose,
+                                          double focal_scale,
+                                          const std::vector<std::pair<int, int>>& pairs) {
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  std::vector<EdgeImage> out(context.edges->size());
+  for (const auto& [e, l] : pairs) {
+    EdgeImage& image = out.at(static_cast<size_t>(e));
+    if (image.visible) continue;  // an edge paired twice
+    ClippedImage((*context.edges)[e], cam_from_world, camera, cam_from_world, camera, &image);
+  }
+  return out;
 }
 
 // Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,

@@ -175,12 +175,13 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       }
       // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
       // explains as many: verified into it again.
+      const int size = static_cast<int>(h.pairs.size());
       for (const VerifiedBasin& b : basins) {
+        if (size > b.lines) continue;  // neither test below can hold: no pair counted
         const int fit =
             static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
               return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
             }));
-        const int size = static_cast<int>(h.pairs.size());
         if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
           return bound;
         }

@@ -215,8 +215,8 @@ bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOpti
 
 double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
                           const VerifiedPose& hypothesis) {
-  const std::vector<EdgeImage> images =
-      ProjectEdges(context, hypothesis.pose, hypothesis.refinement.focal_scale);
+  const std::vector<EdgeImage> images = ProjectPairedEdges(
+      context, hypothesis.pose, hypothesis.refinement.focal_scale, hypothesis.pairs);
   const LineFitModel model = FitModel(context, options);
   double total = 0.0;
   for (const auto& [e, l] : hypothesis.pairs) {

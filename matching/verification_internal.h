@@ -47,6 +47,11 @@ std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
 // The edges' images at `pose`, seen from it.
 std::vector<EdgeImage> ProjectEdges(const VerificationContext& context, const Pose3Dof& pose,
                                     double focal_scale);
+// ProjectEdges' visibility, pixels and world segments for the edges of `pairs` only, without
+// the image lines and their derivatives (the other edges not visible).
+std::vector<EdgeImage> ProjectPairedEdges(const VerificationContext& context, const Pose3Dof& pose,
+                                          double focal_scale,
+                                          const std::vector<std::pair<int, int>>& pairs);
 
 // A line that fits an edge within the gates at the pose.
 struct Candidate {
