@@ -38,8 +38,8 @@ struct LocalizerOptions {
   double unexplained_search_share = 0.25;
   // Budgets of the search of the root branches an exhausted main search did not reach in the
   // pass it stopped in (after the searches over unexplained lines), as a share of the main
-  // search's: depth first, the first branch can take the whole budget (docs/matching.md, ninth
-  // round).
+  // search's: depth first, the first branch can take the whole budget (docs/matching-rounds.md,
+  // ninth round).
   double unsearched_branches_share = 0.1;
 
   bool Check(std::string* why) const;

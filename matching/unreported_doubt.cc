@@ -1,5 +1,5 @@
-// The accepted pose's covariance averaged over its unreported pairs (docs/matching.md, ninth
-// round): law of total covariance over "the group is true" / "the group is clutter".
+// The accepted pose's covariance averaged over its unreported pairs: law of total covariance over
+// "the group is true" / "the group is clutter" (docs/matching-rounds.md, ninth round).
 #include "matching/unreported_doubt.h"
 
 #include <algorithm>
