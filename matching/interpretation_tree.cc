@@ -219,9 +219,6 @@ class TreeSearch {
 
   double Bound() const { return std::max(pass_bound_, visitor_bound_); }
 
-  // One node: `depth` lines decided. The next line is the first undecided one (in cap order)
-  // with a candidate still alive; lines without one are clutter for free (their cap is no longer
-  // in the bound).
   // Records candidate c's assignment to `line` on the branch, and undoes it.
   void Assign(int c, int line) {
     const int edge = candidate_edge_[c];
@@ -255,6 +252,9 @@ class TreeSearch {
     return true;
   }
 
+  // One node: `depth` lines decided. The next line is the first undecided one (in cap order)
+  // with a candidate still alive; lines without one are clutter for free (their cap is no longer
+  // in the bound).
   void Search(size_t depth, const FeasibleRegion& region) {
     if (stats_->nodes >= node_cap_ || stats_->leaves >= leaf_cap_ || stats_->checks >= check_cap_) {
       stats_->budget_exhausted = true;

@@ -7,8 +7,6 @@
 #include <numeric>
 #include <set>
 
-#include <Eigen/Eigenvalues>
-
 #include "matching/unreported_doubt.h"
 #include "models/errors.h"
 
@@ -435,10 +433,7 @@ void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationCon
   }
   result.covariance = covariance.topLeftCorner<3, 3>();
   result.heading_sigma_rad = std::sqrt(covariance(0, 0));
-  result.position_sigma_m =
-      std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
-                                  covariance.block<2, 2>(1, 1), Eigen::EigenvaluesOnly)
-                                  .eigenvalues()[1]));
+  result.position_sigma_m = LargestPositionSigma(covariance.block<2, 2>(1, 1));
   for (const auto& [e, l] : reported)
     result.matches.emplace_back(edges[e].edge_id, l);
   std::sort(result.matches.begin(), result.matches.end());

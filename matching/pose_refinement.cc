@@ -132,10 +132,7 @@ bool UncertaintyOf(const Eigen::Matrix4d& jtj, int dof, Eigen::Matrix4d* covaria
   covariance_out->setZero();
   covariance_out->topLeftCorner(dof, dof) = covariance;
   *heading_sigma = std::sqrt(covariance(0, 0));
-  const Eigen::Matrix2d position = covariance.block<2, 2>(1, 1);
-  *position_sigma = std::sqrt(
-      std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position, Eigen::EigenvaluesOnly)
-                        .eigenvalues()[1]));
+  *position_sigma = LargestPositionSigma(covariance.block<2, 2>(1, 1));
   return true;
 }
 
@@ -171,6 +168,12 @@ double Widening(const PoseBounds& bounds, double sigma) {
 }
 
 }  // namespace
+
+double LargestPositionSigma(const Eigen::Matrix2d& position_covariance) {
+  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+                                     position_covariance, Eigen::EigenvaluesOnly)
+                                     .eigenvalues()[1]));
+}
 
 Eigen::Vector2d BoundsResiduals(const PoseBounds& bounds, const Pose3Dof& pose, double radius_m,
                                 double half_width_rad, Eigen::Matrix<double, 2, 3>* jacobian) {

@@ -128,6 +128,10 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   const PoseView& view, double scale,
                                   Eigen::Matrix<double, 2, 4>* jacobian);
 
+// The largest position standard deviation (metres) of a position covariance (x, y): the square
+// root of its largest eigenvalue (0 when that is negative by rounding).
+double LargestPositionSigma(const Eigen::Matrix2d& position_covariance);
+
 // Refines `start` by Levenberg-Marquardt on all whitened endpoint residuals (Huber-weighted),
 // with the focal scale too when the options ask for it (starting from `start_scale`), and the
 // residuals of options.bounds when active.

@@ -18,11 +18,7 @@ namespace {
 // Position and heading standard deviations of a covariance (heading, x, y, scale) within the
 // options' observability limits.
 bool Observable(const Eigen::Matrix4d& c, const VerificationOptions& options) {
-  const Eigen::Matrix2d position = c.block<2, 2>(1, 1);
-  const double position_variance =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position, Eigen::EigenvaluesOnly)
-          .eigenvalues()[1];
-  return position_variance <= options.max_position_sigma_m * options.max_position_sigma_m &&
+  return LargestPositionSigma(c.block<2, 2>(1, 1)) <= options.max_position_sigma_m &&
          c(0, 0) <=
              DegToRad(options.max_heading_sigma_deg) * DegToRad(options.max_heading_sigma_deg);
 }
