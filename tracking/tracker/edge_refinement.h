@@ -50,6 +50,15 @@ struct KnownHeightTilt {
   double tilt = 0.0;
 };
 
+// One model edge and the sub-pixel edge points the refinement attached to it: the measurements
+// of the pose (tracking/integrity/ computes the pose's covariance and integrity from them).
+struct EdgeObservation {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // world (metres): the edge's part in view
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector2d> points;  // undistorted pixels
+  int model_edge = -1;                  // index of the edge in the refinement's input
+};
+
 // The outcome of RefineOnEdges.
 struct EdgeRefinement {
   bool applied = false;  // false: too few edge points, no improvement, or a refused correction
@@ -63,6 +72,9 @@ struct EdgeRefinement {
   // metres) and heading (radians), from the Gauss-Newton information and the residuals' scale.
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
+  // When applied: the edges and points of the final solve, and the edges set aside.
+  std::vector<EdgeObservation> observations;
+  std::vector<EdgeObservation> set_aside;
 };
 
 // Refines `start` (cam_from_world) so that the model `edges` (world) pass through the sub-pixel

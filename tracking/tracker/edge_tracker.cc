@@ -219,8 +219,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
   health.edges_total = sites.total;
   health.edges_good = static_cast<int>(sites.good.size());
   if (settings_.refine_subpixel) {
-    const EdgeRefinement refined = RefineOnEdges(
-        image, camera_, edges_, sites.good, result.cam_from_world, settings_.refinement, known);
+    EdgeRefinement refined = RefineOnEdges(image, camera_, edges_, sites.good,
+                                           result.cam_from_world, settings_.refinement, known);
     health.refined = refined.applied;
     health.refined_points = refined.points;
     if (refined.applied) {
@@ -230,6 +230,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       health.refined_rejected_edges = refined.rejected_edges;
       health.refined_position_sigma_m = refined.position_sigma_m;
       health.refined_heading_sigma_deg = RadToDeg(refined.heading_sigma_rad);
+      result.observations = std::move(refined.observations);
+      result.set_aside = std::move(refined.set_aside);
     }
   }
   if (!with_covariance) return result;
