@@ -137,6 +137,29 @@ TEST(IntegrityMonitor, ExcludesAnEdgeLatchedThreePixelsOntoAParallelLine) {
   EXPECT_EQ(excluded_wrong, 0);
 }
 
+// A free camera (6 unknowns): a floor line latched 3 px is excluded, and the pose is tracking
+// within its protection levels (camera centre, rotation angle).
+TEST(IntegrityMonitor, FreeCameraExcludesALatchedFloorLine) {
+  const CameraIntrinsics camera = TestCamera();
+  const Eigen::Isometry3d truth = CamFromWorld(TestRobotPose());
+  const std::vector<Segment3> edges = RoomEdges();
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    std::vector<double> shift(edges.size(), 0.0);
+    shift[kFloorLines[0]] = kLatchPx;
+    std::mt19937 random(300 + seed);
+    const std::vector<EdgeObservation> observations =
+        Observe(edges, camera, truth, RealisticNoise(), &random, shift);
+    const PoseIntegrity p = EvaluatePoseIntegrity(
+        observations, camera, Start(truth), PoseParameterisation(), OptionsFor(RealisticNoise()));
+    EXPECT_EQ(p.status, PoseStatus::kTracking) << p.reason;
+    ASSERT_EQ(p.excluded.size(), 1u) << p.reason;
+    EXPECT_EQ(observations[p.excluded[0]].model_edge, kFloorLines[0]);
+    const WorldTwist e = WorldTwistBetween(truth, p.solution.cam_from_world);
+    EXPECT_LE(e.head<3>().norm(), p.levels.position_m);
+    EXPECT_LE(e.tail<3>().norm(), p.levels.rotation_rad);
+  }
+}
+
 // Faults of 0.5 to 2.5 px on one edge, detected or not: no pose that is not lost has an error
 // beyond its protection levels (an integrity failure); the covariance averaged over the fault
 // hypotheses holds more truths in its 99.9 % region than the fault-free one, and when the fault

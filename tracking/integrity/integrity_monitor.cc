@@ -106,21 +106,18 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
   const bool position_ok = pl.position_m <= options.alert_position_m;
   const bool rotation_ok = pl.rotation_rad <= options.alert_rotation_rad;
   out->status = position_ok && rotation_ok ? PoseStatus::kTracking : PoseStatus::kDegraded;
-  std::vector<std::string> parts;
+  if (!std::isfinite(pl.position_m) || !std::isfinite(pl.rotation_rad)) {
+    Append(&out->reason, "a fault of one edge would go unnoticed");
+    return;
+  }
   if (!position_ok) {
-    parts.push_back(std::isfinite(pl.position_m)
-                        ? "position protection " + Fixed(pl.position_m, 3) + " m > " +
-                              Fixed(options.alert_position_m, 3) + " m"
-                        : "a fault of one edge would go unnoticed");
+    Append(&out->reason, "position protection " + Fixed(pl.position_m, 3) + " m > " +
+                             Fixed(options.alert_position_m, 3) + " m");
   }
-  if (!rotation_ok && std::isfinite(pl.rotation_rad)) {
-    parts.push_back("rotation protection " + Fixed(RadToDeg(pl.rotation_rad), 2) + " deg > " +
-                    Fixed(RadToDeg(options.alert_rotation_rad), 2) + " deg");
+  if (!rotation_ok) {
+    Append(&out->reason, "rotation protection " + Fixed(RadToDeg(pl.rotation_rad), 2) + " deg > " +
+                             Fixed(RadToDeg(options.alert_rotation_rad), 2) + " deg");
   }
-  std::string reason;
-  for (const std::string& p : parts)
-    reason += (reason.empty() ? "" : "; ") + p;
-  Append(&out->reason, reason);
 }
 
 }  // namespace

@@ -103,7 +103,8 @@ struct PoseIntegrity {
   std::string reason;  // why degraded or lost, and which edges were excluded
   // The pose (cam_from_world), the fault-free covariance of the unknowns, the noise scales.
   EdgePoseSolution solution;
-  // The covariance to report: the unknowns' (FaultAwareCovariance), and the world twist's 6 x 6.
+  // The covariance to report (not when lost): the unknowns' (FaultAwareCovariance), and the world
+  // twist's 6 x 6 (WorldTwistCovariance plus the same fault terms).
   Eigen::MatrixXd covariance;
   Eigen::Matrix<double, 6, 6> world_covariance =
       Eigen::Matrix<double, 6, 6>::Constant(std::numeric_limits<double>::infinity());
