@@ -18,6 +18,7 @@
 #include "matching/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
+#include "models/statistics.h"
 #include "models/synthetic_scenes.h"
 
 namespace linetrack::app {
@@ -62,13 +63,6 @@ struct Tally {
 
   int Total() const { return correct + none + wrong_accurate + wrong; }
 };
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  return v[i];
-}
 
 using Outcome = MatchOutcome;
 
@@ -266,11 +260,11 @@ std::string Row(const std::string& matcher, const Tally& t) {
   const double n = std::max(1, t.Total());
   row << std::fixed << "| " << matcher << " | " << t.correct << " (" << std::setprecision(1)
       << 100.0 * t.correct / n << " %) | " << t.none << " | " << t.wrong_accurate << " | "
-      << t.wrong << " | " << std::setprecision(0) << Percentile(t.hypotheses, 0.5) << " / "
-      << Percentile(t.hypotheses, 1.0) << " | " << std::setprecision(2)
-      << Percentile(t.times_ms, 0.5) << " / " << Percentile(t.times_ms, 0.99) << " | "
-      << std::setprecision(3) << Percentile(t.position_error_m, 0.5) << " m, "
-      << std::setprecision(2) << Percentile(t.heading_error_deg, 0.5) << " deg |";
+      << t.wrong << " | " << std::setprecision(0) << QuantileNearestRank(t.hypotheses, 0.5) << " / "
+      << QuantileNearestRank(t.hypotheses, 1.0) << " | " << std::setprecision(2)
+      << QuantileNearestRank(t.times_ms, 0.5) << " / " << QuantileNearestRank(t.times_ms, 0.99)
+      << " | " << std::setprecision(3) << QuantileNearestRank(t.position_error_m, 0.5) << " m, "
+      << std::setprecision(2) << QuantileNearestRank(t.heading_error_deg, 0.5) << " deg |";
   return row.str();
 }
 

@@ -5,8 +5,8 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/statistics.h"
 #include "tracking/live/sim_rig.h"
-#include "tracking/tracker/track_bench.h"
 #include "tracking/tracker/tracking_health.h"
 
 namespace linetrack {
@@ -55,7 +55,7 @@ ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig,
     for (double e : settled)
       sum += e;
     run.mean_error_px = sum / settled.size();
-    run.p95_error_px = Quantile(settled, 0.95);
+    run.p95_error_px = QuantileNearestRank(settled, 0.95);
     run.max_error_px = *std::max_element(settled.begin(), settled.end());
   }
   return run;

@@ -105,14 +105,6 @@ std::vector<BenchSequence> VispBenchSequences(const std::string& visp_images,
   return sequences;
 }
 
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = std::min(values.size() - 1,
-                            static_cast<size_t>(std::max(0.0, q) * (values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
-
 TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats) {
   const std::vector<vpImage<unsigned char>> frames = LoadFrames(sequence.images);
   CameraIntrinsics camera = sequence.camera;

@@ -54,7 +54,4 @@ struct TrackBenchResult {
 // is missing.
 TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats);
 
-// The q-quantile (0..1) of `values` (nearest rank); 0 for none.
-double Quantile(std::vector<double> values, double q);
-
 }  // namespace linetrack
