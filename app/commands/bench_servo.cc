@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/bench/servo_bench.h"
 #include "app/commands.h"
 #include "app/localize_image.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/statistics.h"
-#include "tracking/live/servo_bench.h"
 
 namespace linetrack::app {
 namespace {

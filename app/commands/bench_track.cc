@@ -10,10 +10,10 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "app/bench/track_bench.h"
 #include "app/commands.h"
 #include "models/errors.h"
 #include "models/statistics.h"
-#include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
 namespace {

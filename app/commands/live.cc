@@ -30,7 +30,7 @@
 #include "tracking/capture/source_factory.h"
 #include "tracking/head/head_factory.h"
 #include "tracking/live/live_overlay.h"
-#include "tracking/live/servo_bench.h"
+#include "tracking/live/sim_camera.h"
 
 namespace linetrack::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "tracking/capture/capture_bench.h"
+#include "app/bench/capture_bench.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,7 +6,7 @@
 
 #include "models/statistics.h"
 
-namespace linetrack {
+namespace linetrack::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -68,4 +68,4 @@ CaptureBenchResult RunCaptureBenchmark(FrameSource* source, const CaptureBenchOp
   return result;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app

@@ -1,4 +1,4 @@
-#include "tracking/live/servo_bench.h"
+#include "app/bench/servo_bench.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include "tracking/live/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
-namespace linetrack {
+namespace linetrack::app {
 namespace {
 
 constexpr double kConvergedPx = 2.0;
@@ -129,4 +129,4 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
   return runs;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app

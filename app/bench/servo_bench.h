@@ -15,7 +15,7 @@
 #include "tracking/live/tracker_estimator.h"
 #include "tracking/servo/head_servo.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 struct ServoBenchOptions {
   double fps = 30.0;            // simulated frame rate
@@ -67,4 +67,4 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
                                          const CameraIntrinsics& camera,
                                          const ServoBenchOptions& options);
 
-}  // namespace linetrack
+}  // namespace linetrack::app

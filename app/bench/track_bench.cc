@@ -1,4 +1,4 @@
-#include "tracking/tracker/track_bench.h"
+#include "app/bench/track_bench.h"
 
 #include <visp3/core/vpException.h>
 #include <visp3/mbt/vpMbGenericTracker.h>
@@ -17,7 +17,7 @@
 #include "tracking/tracker/pose_file.h"
 #include "tracking/tracker/sequence_tracker.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 namespace {
 
@@ -168,4 +168,4 @@ TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats) {
   return result;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app
