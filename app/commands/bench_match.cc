@@ -19,7 +19,7 @@
 #include "matching/localizer.h"
 #include "models/errors.h"
 #include "models/statistics.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 namespace {

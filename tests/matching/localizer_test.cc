@@ -16,7 +16,7 @@
 #include "matching/diagnosis.h"
 #include "matching/interpretation_tree.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {

@@ -12,7 +12,7 @@
 #include "matching/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/statistics.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {
