@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/occlusion.h"

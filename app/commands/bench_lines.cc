@@ -19,7 +19,7 @@
 #include "app/commands.h"
 #include "app/image_overlay.h"
 #include "app/rendered_cases.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/statistics.h"

@@ -16,7 +16,7 @@
 #include "app/localize_image.h"
 #include "app/match_outcome.h"
 #include "app/rendered_cases.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "matching/localizer.h"
 #include "models/errors.h"

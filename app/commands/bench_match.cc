@@ -15,7 +15,8 @@
 
 #include "app/commands.h"
 #include "app/match_outcome.h"
-#include "matching/diagnosis.h"
+#include "matching/evaluation/baseline_sampler.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
 #include "models/statistics.h"
@@ -306,7 +307,9 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     LocalizerOptions tree_options;
     LocalizerOptions baseline_options;
     baseline_options.method = MatchMethod::kHypothesizeAndTest;
-    baseline_options.baseline.max_samples = opt.baseline_samples;
+    BaselineOptions baseline_sampling;
+    baseline_sampling.max_samples = opt.baseline_samples;
+    baseline_options.sampler = BaselineSampler(baseline_sampling);
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);
     Tally tree_tally, baseline_tally;

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/render/scene_renderer.h"

@@ -13,7 +13,7 @@
 #include <algorithm>
 #include <set>
 
-#include "matching/diagnosis.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/interpretation_tree.h"
 #include "models/errors.h"
 #include "models/synth/synthetic_scenes.h"

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "matching/diagnosis.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/statistics.h"
 #include "models/synth/synthetic_scenes.h"
