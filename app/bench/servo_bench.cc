@@ -6,7 +6,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/statistics.h"
-#include "tracking/live/sim_rig.h"
+#include "tracking/sim/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
 namespace linetrack::app {

@@ -11,9 +11,9 @@
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
-#include "tracking/live/sim_camera.h"
 #include "tracking/live/tracker_estimator.h"
 #include "tracking/servo/head_servo.h"
+#include "tracking/sim/sim_camera.h"
 
 namespace linetrack::app {
 

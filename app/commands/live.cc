@@ -30,7 +30,7 @@
 #include "tracking/capture/source_factory.h"
 #include "tracking/head/head_factory.h"
 #include "tracking/live/live_overlay.h"
-#include "tracking/live/sim_camera.h"
+#include "tracking/sim/sim_camera.h"
 
 namespace linetrack::app {
 namespace {

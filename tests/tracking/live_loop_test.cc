@@ -19,8 +19,8 @@
 #include "tracking/head/ptu_emulator.h"
 #include "tracking/head/ptu_protocol.h"
 #include "tracking/live/live_loop.h"
-#include "tracking/live/sim_camera.h"
-#include "tracking/live/sim_rig.h"
+#include "tracking/sim/sim_camera.h"
+#include "tracking/sim/sim_rig.h"
 
 namespace linetrack {
 namespace {
