@@ -7,9 +7,9 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "tests/support/ptu_emulator.h"
 #include "tracking/head/head_factory.h"
 #include "tracking/head/ptu_driver.h"
-#include "tracking/head/ptu_emulator.h"
 #include "tracking/head/ptu_protocol.h"
 #include "tracking/sim/simulated_head.h"
 
