@@ -107,7 +107,7 @@ Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, dou
   return outcome;
 }
 
-// The first stage at which the truth is lost (see matching/diagnosis.h).
+// The first stage at which the truth is lost (see matching/evaluation/diagnosis.h).
 std::string Classify(const TruthDiagnosis& d, const LocalizationResult& result) {
   if (!d.plausible && d.implausible_because == "unobservable") return "uninformative truth";
   if (d.candidate_edges < d.true_edges) return "true edge not a candidate";
@@ -395,8 +395,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->add_option("--diagnose", opt->diagnose_path,
                   "Write a JSON line per scene the tree does not answer correctly: where the "
-                  "true correspondences are lost (matching/diagnosis.h); and a short one per "
-                  "correct answer whose search budget ran out");
+                  "true correspondences are lost (matching/evaluation/diagnosis.h); and a short "
+                  "one per correct answer whose search budget ran out");
   cmd->add_option("--only", opt->only,
                   "Run only these scene indices (0-based, of the --count generated; debugging)")
       ->delimiter(',');
