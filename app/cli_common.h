@@ -35,6 +35,12 @@ std::vector<double> ParseNumbers(const std::string& text, int count, const std::
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
 void CheckRange(double value, double lo, double hi, const std::string& flag);
 
+// Throws InputError (naming `what`, e.g. "x.csv: --prior-file") unless some of `times` (seconds,
+// already shifted by any --time-offset) fall within [first - tolerance, last + tolerance], the
+// frames' times: a file stamped in another time base (epoch seconds against frames from 0).
+void CheckTimesOverlap(const std::vector<double>& times, double first, double last,
+                       double tolerance, const std::string& what);
+
 // Writes `content` to `path` through a temporary file renamed into place, so that a reader never
 // sees a partial file. Throws InputError when the file cannot be written.
 void WriteFileAtomically(const std::string& path, const std::string& content);

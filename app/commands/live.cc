@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/integrity_output.h"
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
@@ -49,6 +50,7 @@ struct LiveCommandOptions {
   bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
   double camera_fps = 0.0;
+  IntegrityFlags integrity;
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -212,6 +214,7 @@ int RunLive(const LiveCommandOptions& opt) {
     throw InputError(opt.prior_file + ": no prior rows");
   }
   inputs.tracker.matcher.noise = DetectedLineNoise();
+  inputs.tracker.sequence.integrity = opt.integrity.Options();
   if (!opt.settings.empty()) inputs.tracker.settings = ReadTrackerSettings(opt.settings);
   std::optional<NavigableArea> area;
   if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
@@ -225,7 +228,8 @@ int RunLive(const LiveCommandOptions& opt) {
   LiveLoop& loop = session.loop();
   const CameraIntrinsics& camera = inputs.camera;
 
-  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr);
+  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr, opt.integrity.all_poses);
+  IntegrityTally integrity;
   spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
                session.DescribeHead(), session.DescribeEstimator(), plan.duration);
   const std::vector<ProjectedEdge> no_edges;
@@ -260,6 +264,12 @@ int RunLive(const LiveCommandOptions& opt) {
           spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
         }
         output.Add(it, session.truth());
+        std::optional<IntegrityCheck> check;
+        if (it.estimate.has_pose() && session.truth() != nullptr) {
+          check = CheckAgainstTruth(it.estimate.uncertainty, *it.estimate.cam_from_world,
+                                    *session.truth(), /*robot=*/true);
+        }
+        integrity.Add(it.estimate.uncertainty, check);
         const bool snapshot =
             opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
         const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
@@ -299,6 +309,7 @@ int RunLive(const LiveCommandOptions& opt) {
   json["estimator"] = session.DescribeEstimator();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
+  json["integrity"] = integrity.Summary(inputs.tracker.sequence.integrity);
   output.Finish(json);
   if (failure) std::rethrow_exception(failure);
   std::cout << "live: " << summary.frames << " frames, " << summary.with_pose << " with a pose, "
@@ -356,6 +367,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                   "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
+  AddIntegrityFlags(cmd, &opt->integrity);
+  AddAllPosesFlag(cmd, &opt->integrity);
   cmd->add_option("--camera-fps", opt->camera_fps,
                   "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {

@@ -5,15 +5,18 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/integrity_output.h"
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
@@ -36,9 +39,12 @@ struct ReplayOptions {
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
   double fps = 0.0;
+  double time_offset = 0.0;  // seconds added to the frames' times to read priors, ground truth
+  bool align_times = false;  // time_offset = first prior (or ground-truth) time - first frame's
   long max_frames = 0;
   bool overlay_png = false, no_overlay = false, scanline = false;
   LineFlags lines;  // the line extractor of the re-localisation
+  IntegrityFlags integrity;
 };
 
 double Milliseconds(Clock::duration d) {
@@ -97,7 +103,42 @@ struct ReplaySetup {
   std::unique_ptr<VideoSource> source;
   Frame first;
   double fps = 30.0;
+  double time_offset = 0.0;  // --time-offset or --align-times
 };
+
+// The offset between the frames' times and those of the prior file and ground truth (given, or
+// aligning the first stamps), then a check that they overlap (one line, exit 2, when not).
+void AlignTimes(const ReplayOptions& opt, long frames, ReplaySetup* s) {
+  std::vector<double> prior_times;
+  for (const PriorRecord& r : s->priors)
+    prior_times.push_back(r.t);
+  const std::vector<double> truth_times = s->ground_truth->Times();
+  const double first = s->first.timestamp_s;
+  s->time_offset = opt.time_offset;
+  if (opt.align_times && opt.time_offset != 0.0) {
+    throw InputError("replay: give either --time-offset or --align-times, not both");
+  }
+  if (opt.align_times) {
+    const std::vector<double>& times = prior_times.empty() ? truth_times : prior_times;
+    if (times.empty()) throw InputError("--align-times: no prior file or ground-truth times");
+    s->time_offset = *std::min_element(times.begin(), times.end()) - first;
+  }
+  // Frame times from the first to the last frame read (all of them when the count is unknown).
+  const long count =
+      opt.max_frames > 0 && (frames <= 0 || opt.max_frames < frames) ? opt.max_frames : frames;
+  const double last =
+      count > 0 ? first + (count - 1) / s->fps : std::numeric_limits<double>::infinity();
+  auto shifted = [&](std::vector<double> times) {
+    for (double& t : times)
+      t -= s->time_offset;
+    return times;
+  };
+  const double tolerance = 1.0 / s->fps + 0.5;
+  CheckTimesOverlap(shifted(prior_times), first, last, tolerance,
+                    opt.prior_file + ": --prior-file");
+  CheckTimesOverlap(shifted(truth_times), first, last, tolerance,
+                    opt.ground_truth + ": --ground-truth");
+}
 
 ReplaySetup Prepare(const ReplayOptions& opt) {
   ReplaySetup s;
@@ -160,6 +201,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
                      std::to_string(width) + "x" + std::to_string(height));
   }
   s.fps = source_options.frame_rate > 0.0 ? source_options.frame_rate : 30.0;
+  AlignTimes(opt, s.source->FrameCount(), &s);
   return s;
 }
 
@@ -167,7 +209,8 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
   if (!s.robot) return std::nullopt;
   RobotReading reading;
   if (!s.priors.empty()) {
-    const std::optional<RobotPose> prior = InterpolatePrior(s.priors, t, 1.0 / s.fps + 0.5);
+    const std::optional<RobotPose> prior =
+        InterpolatePrior(s.priors, t + s.time_offset, 1.0 / s.fps + 0.5);
     if (!prior) return std::nullopt;  // outside the prior file: a free frame
     reading.odometry = prior->Planar();
     reading.height = prior->height;
@@ -224,14 +267,17 @@ int RunReplay(const ReplayOptions& opt) {
     relocalizer = std::make_unique<Relocalizer>(
         *localizer, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
   }
-  SequenceTracker sequence(&tracker, s.camera, relocalizer.get(), SequenceTrackerOptions());
+  SequenceTrackerOptions sequence_options;
+  sequence_options.integrity = opt.integrity.Options();
+  SequenceTracker sequence(&tracker, s.camera, relocalizer.get(), sequence_options);
   if (s.start_pose) sequence.SetStartPose(*s.start_pose);
   if (s.initial_prior) sequence.SetInitialPrior(*s.initial_prior);
   const OcclusionTester occlusion(*loaded.model);
 
   // Everything is valid: the outputs appear from here on, frame by frame.
   EnsureDirectory(opt.out);
-  ReplayLog log(opt.out, s.ground_truth->enabled());
+  ReplayLog log(opt.out, s.ground_truth->enabled(), opt.integrity.all_poses);
+  IntegrityTally integrity;
   std::unique_ptr<OverlayWriter> overlay;
   if (!opt.no_overlay) {
     overlay = std::make_unique<OverlayWriter>(opt.out, opt.overlay_png, s.fps,
@@ -247,6 +293,7 @@ int RunReplay(const ReplayOptions& opt) {
   auto write_summary = [&](const std::vector<ReplayFrameRecord>& records) {
     info.losses = sequence.losses();
     info.recoveries = sequence.recoveries();
+    info.integrity = integrity.Summary(sequence_options.integrity);
     WriteFileAtomically(opt.out + "/summary.json", ReplaySummary(records, info).dump(2) + "\n");
   };
 
@@ -274,14 +321,18 @@ int RunReplay(const ReplayOptions& opt) {
     record.edges_good = report.health.edges_good;
     record.step_ms = Milliseconds(Clock::now() - step_start);
     record.decode_ms = decode_ms;
+    std::optional<IntegrityCheck> check;
     if (report.cam_from_world) {
       ++with_pose;
-      if (const auto truth = s.ground_truth->At(record.frame, record.t, 0.5 / s.fps)) {
+      if (const auto truth =
+              s.ground_truth->At(record.frame, record.t + s.time_offset, 0.5 / s.fps)) {
         const PoseDifference d = ComparePoses(*report.cam_from_world, *truth);
         record.translation_error_m = d.translation;
         record.rotation_error_deg = RadToDeg(d.rotation);
+        check = CheckAgainstTruth(report.uncertainty, *report.cam_from_world, *truth, s.robot);
       }
     }
+    integrity.Add(report.uncertainty, check);
     log.Add(record, report);
     records.push_back(record);
     if (overlay) {
@@ -343,8 +394,9 @@ int RunReplay(const ReplayOptions& opt) {
   write_summary(records);
   const nlohmann::ordered_json summary = ReplaySummary(records, info);
   std::cout << "replayed " << records.size() << " frames: " << with_pose << " with a pose ("
-            << summary["status_counts"].dump() << "), " << sequence.losses() << " losses, "
-            << sequence.recoveries() << " recoveries, "
+            << summary["status_counts"].dump() << "; integrity "
+            << summary["integrity"]["status_counts"].dump() << "), " << sequence.losses()
+            << " losses, " << sequence.recoveries() << " recoveries, "
             << static_cast<int>(summary["throughput_fps"].get<double>())
             << " frames/s without the overlay";
   if (summary.contains("ground_truth")) {
@@ -352,6 +404,10 @@ int RunReplay(const ReplayOptions& opt) {
               << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0 << " cm, worst "
               << summary["ground_truth"]["translation_m"]["max"].get<double>() * 100.0 << " cm / "
               << summary["ground_truth"]["rotation_deg"]["max"].get<double>() << " deg";
+  }
+  if (summary["integrity"].contains("ground_truth")) {
+    std::cout << "; integrity failures "
+              << summary["integrity"]["ground_truth"]["integrity_failures"].get<int>();
   }
   std::cout << (info.complete ? "" : " (interrupted: " + info.interruption + ")") << std::endl;
   return info.complete && with_pose > 0 ? kExitOk : kExitJobFailed;
@@ -391,10 +447,18 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
       "--fps", opt->fps,
       "Frame rate (default: the video's, else the prior or ground-truth time step, else "
       "30)");
+  cmd->add_option("--time-offset", opt->time_offset,
+                  "Seconds added to the frames' times to read --prior-file and --ground-truth "
+                  "(their time base minus the frames')")
+      ->capture_default_str();
+  cmd->add_flag("--align-times", opt->align_times,
+                "Align the first time of --prior-file (else --ground-truth) on the first frame's");
   cmd->add_option("--frames", opt->max_frames, "Stop after this many frames (0: all)");
   cmd->add_flag("--overlay-png", opt->overlay_png, "Overlay as DIR/overlay/frame_%05d.png");
   cmd->add_flag("--no-overlay", opt->no_overlay, "No overlay");
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
+  AddIntegrityFlags(cmd, &opt->integrity);
+  AddAllPosesFlag(cmd, &opt->integrity);
   cmd->add_flag("--scanline", opt->scanline,
                 "Scan-line visibility (hidden edge parts not tracked; about 4x slower)");
   cmd->callback([opt, action] { *action = [opt] { return RunReplay(*opt); }; });

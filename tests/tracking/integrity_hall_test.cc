@@ -116,10 +116,10 @@ HallFigures Score(const IntegrityOptions& options, bool fault_aware = true) {
     const PoseParameterisation parameters(KnownHeightTilt{truth.height, truth.tilt});
     const PoseIntegrity p =
         EvaluatePoseIntegrity(m.observations, camera, m.refined, parameters, options);
-    f.tracking += p.status == PoseStatus::kTracking;
-    f.degraded += p.status == PoseStatus::kDegraded;
-    f.lost += p.status == PoseStatus::kLost;
-    if (p.status == PoseStatus::kLost) continue;
+    f.tracking += p.status == IntegrityStatus::kTracking;
+    f.degraded += p.status == IntegrityStatus::kDegraded;
+    f.lost += p.status == IntegrityStatus::kLost;
+    if (p.status == IntegrityStatus::kLost) continue;
     const Eigen::VectorXd e =
         parameters.Difference(p.solution.cam_from_world, hall.frames[i].cam_from_world);
     const Eigen::MatrixXd& covariance = fault_aware ? p.covariance : p.solution.covariance;
@@ -129,7 +129,7 @@ HallFigures Score(const IntegrityOptions& options, bool fault_aware = true) {
                  e.head<2>().norm());
     heading.Add(e[2] * e[2] / covariance(2, 2), RadToDeg(sigmas[1]), RadToDeg(std::abs(e[2])));
     f.integrity_failures +=
-        p.status == PoseStatus::kTracking &&
+        p.status == IntegrityStatus::kTracking &&
         (e.head<2>().norm() > p.levels.position_m || std::abs(e[2]) > p.levels.rotation_rad);
   }
   f.pose = pose.Summary();

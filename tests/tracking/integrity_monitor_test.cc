@@ -81,7 +81,7 @@ TEST(IntegrityMonitor, FaultFreePoseIsTrackingAndDegradedBelowItsProtectionLevel
   IntegrityOptions options = OptionsFor(RealisticNoise());
   const PoseIntegrity p =
       EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
-  EXPECT_EQ(p.status, PoseStatus::kTracking) << p.reason;
+  EXPECT_EQ(p.status, IntegrityStatus::kTracking) << p.reason;
   EXPECT_TRUE(p.excluded.empty()) << p.reason;
   const Eigen::Vector2d errors = RobotErrors(p.solution.cam_from_world, truth);
   EXPECT_LE(errors[0], p.levels.position_m);
@@ -90,7 +90,7 @@ TEST(IntegrityMonitor, FaultFreePoseIsTrackingAndDegradedBelowItsProtectionLevel
   options.alert_position_m = 0.5 * p.levels.position_m;
   const PoseIntegrity tight =
       EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
-  EXPECT_EQ(tight.status, PoseStatus::kDegraded);
+  EXPECT_EQ(tight.status, IntegrityStatus::kDegraded);
   EXPECT_NE(tight.reason.find("position protection"), std::string::npos) << tight.reason;
 }
 
@@ -118,7 +118,7 @@ TEST(IntegrityMonitor, ExcludesAnEdgeLatchedThreePixelsOntoAParallelLine) {
       ++cases;
       const PoseIntegrity p =
           EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
-      ASSERT_NE(p.status, PoseStatus::kLost) << "edge " << k << ": " << p.reason;
+      ASSERT_NE(p.status, IntegrityStatus::kLost) << "edge " << k << ": " << p.reason;
       const int index = static_cast<int>(it - observations.begin());
       const bool found = std::count(p.excluded.begin(), p.excluded.end(), index) > 0;
       excluded_right += found;
@@ -151,7 +151,7 @@ TEST(IntegrityMonitor, FreeCameraExcludesALatchedFloorLine) {
         Observe(edges, camera, truth, RealisticNoise(), &random, shift);
     const PoseIntegrity p = EvaluatePoseIntegrity(
         observations, camera, Start(truth), PoseParameterisation(), OptionsFor(RealisticNoise()));
-    EXPECT_EQ(p.status, PoseStatus::kTracking) << p.reason;
+    EXPECT_EQ(p.status, IntegrityStatus::kTracking) << p.reason;
     ASSERT_EQ(p.excluded.size(), 1u) << p.reason;
     EXPECT_EQ(observations[p.excluded[0]].model_edge, kFloorLines[0]);
     const WorldTwist e = WorldTwistBetween(truth, p.solution.cam_from_world);
@@ -182,7 +182,7 @@ TEST(IntegrityMonitor, ProtectionLevelsBoundTheErrorOfUndetectedFaults) {
             Observe(edges, camera, truth, RealisticNoise(), &random, shift);
         const PoseIntegrity p =
             EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
-        if (p.status == PoseStatus::kLost) continue;
+        if (p.status == IntegrityStatus::kLost) continue;
         ++poses;
         excluded += !p.excluded.empty();
         const Eigen::VectorXd e = RobotParameters().Difference(p.solution.cam_from_world, truth);
@@ -299,7 +299,7 @@ TEST(IntegrityMonitor, ParallelLinesAloneAreLost) {
   ASSERT_GE(parallel.size(), 3u);
   const PoseIntegrity p = EvaluatePoseIntegrity(parallel, camera, Start(truth), RobotParameters(),
                                                 OptionsFor(RealisticNoise()));
-  EXPECT_EQ(p.status, PoseStatus::kLost);
+  EXPECT_EQ(p.status, IntegrityStatus::kLost);
   EXPECT_NE(p.reason.find("do not fix"), std::string::npos) << p.reason;
 }
 

@@ -105,7 +105,8 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
   const ProtectionLevels& pl = out->levels;
   const bool position_ok = pl.position_m <= options.alert_position_m;
   const bool rotation_ok = pl.rotation_rad <= options.alert_rotation_rad;
-  out->status = position_ok && rotation_ok ? PoseStatus::kTracking : PoseStatus::kDegraded;
+  out->status =
+      position_ok && rotation_ok ? IntegrityStatus::kTracking : IntegrityStatus::kDegraded;
   if (!std::isfinite(pl.position_m) || !std::isfinite(pl.rotation_rad)) {
     Append(&out->reason, "a fault of one edge would go unnoticed");
     return;
@@ -122,13 +123,13 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
 
 }  // namespace
 
-const char* PoseStatusName(PoseStatus status) {
+const char* ToString(IntegrityStatus status) {
   switch (status) {
-    case PoseStatus::kTracking:
+    case IntegrityStatus::kTracking:
       return "tracking";
-    case PoseStatus::kDegraded:
+    case IntegrityStatus::kDegraded:
       return "degraded";
-    case PoseStatus::kLost:
+    case IntegrityStatus::kLost:
       return "lost";
   }
   return "lost";
@@ -294,7 +295,7 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
       out.solution.reason = "only " + std::to_string(out.solution.edges.size()) + " edges";
     }
     if (!out.solution.ok) {
-      out.status = PoseStatus::kLost;
+      out.status = IntegrityStatus::kLost;
       Append(&out.reason, out.solution.reason);
       return out;
     }
@@ -313,7 +314,7 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
     const std::string fault = EdgeName(observations, worst->observation) + " inconsistent (" +
                               Fixed(worst->test, 1) + " > " + Fixed(worst->threshold, 1) + ")";
     if (attempt == options.max_exclusions) {
-      out.status = PoseStatus::kLost;
+      out.status = IntegrityStatus::kLost;
       Append(&out.reason, fault + " after " + std::to_string(attempt) + " exclusions");
       return out;
     }
@@ -332,6 +333,24 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
   out.position_sigma_m = sigmas[0];
   out.rotation_sigma_rad = sigmas[1];
   Judge(options, &out);
+  return out;
+}
+
+PoseUncertainty UncertaintyOf(const PoseIntegrity& integrity) {
+  PoseUncertainty out;
+  out.status = integrity.status;
+  out.reason = integrity.reason;
+  out.excluded_edges = static_cast<int>(integrity.excluded.size());
+  if (integrity.status == IntegrityStatus::kLost || !integrity.world_covariance.allFinite()) {
+    return out;
+  }
+  out.world_covariance = integrity.world_covariance;
+  const Eigen::Matrix<double, 6, 1> variances = out.world_covariance.diagonal().cwiseMax(0.0);
+  out.sigma_x_m = std::sqrt(variances[0]);
+  out.sigma_y_m = std::sqrt(variances[1]);
+  out.sigma_heading_rad = std::sqrt(variances[5]);
+  out.protection_position_m = integrity.levels.position_m;
+  out.protection_rotation_rad = integrity.levels.rotation_rad;
   return out;
 }
 

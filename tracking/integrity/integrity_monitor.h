@@ -18,8 +18,8 @@ namespace linetrack {
 
 // tracking: the protection levels are within the alert limits; degraded: a pose with its
 // covariance that no one should act on blindly; lost: no pose can be trusted.
-enum class PoseStatus { kTracking, kDegraded, kLost };
-const char* PoseStatusName(PoseStatus status);
+enum class IntegrityStatus { kTracking, kDegraded, kLost };
+const char* ToString(IntegrityStatus status);
 
 struct IntegrityOptions {
   EdgePoseSolverOptions solver;
@@ -99,7 +99,7 @@ ProtectionLevels ComputeProtectionLevels(const EdgePoseSolution& solution,
 
 // A tracked pose with its covariance, protection levels and status.
 struct PoseIntegrity {
-  PoseStatus status = PoseStatus::kLost;
+  IntegrityStatus status = IntegrityStatus::kLost;
   std::string reason;  // why degraded or lost, and which edges were excluded
   // The pose (cam_from_world), the fault-free covariance of the unknowns, the noise scales.
   EdgePoseSolution solution;
@@ -123,6 +123,27 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
                                     const PoseParameterisation& parameters,
                                     const IntegrityOptions& options,
                                     const std::optional<PosePrior>& prior = std::nullopt);
+
+// What a frame reports of its pose's integrity (frames.csv, covariance.jsonl): the status and why,
+// the 6 x 6 covariance of the world twist (dC, omega; metres, radians; WorldTwist), the standard
+// deviations of x, y (world, metres) and heading (omega_z, radians), and the protection levels.
+struct PoseUncertainty {
+  IntegrityStatus status = IntegrityStatus::kLost;
+  std::string reason;
+  Eigen::Matrix<double, 6, 6> world_covariance =
+      Eigen::Matrix<double, 6, 6>::Constant(std::numeric_limits<double>::infinity());
+  double sigma_x_m = std::numeric_limits<double>::infinity();
+  double sigma_y_m = std::numeric_limits<double>::infinity();
+  double sigma_heading_rad = std::numeric_limits<double>::infinity();
+  double protection_position_m = std::numeric_limits<double>::infinity();
+  double protection_rotation_rad = std::numeric_limits<double>::infinity();
+  int excluded_edges = 0;
+
+  bool has_covariance() const { return world_covariance.allFinite(); }
+};
+
+// The report of a monitored pose (infinite sigmas and levels when lost).
+PoseUncertainty UncertaintyOf(const PoseIntegrity& integrity);
 
 // Largest standard deviation of the position and rotation blocks of a covariance of the unknowns
 // (robot: x, y | heading; free: C | omega).

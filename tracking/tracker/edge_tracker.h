@@ -33,8 +33,8 @@ struct EdgeTrackResult {
   TrackHealth health;       // measured by Track() (Start() measures nothing)
   double passes_ms = 0.0;   // Track(): wall clock in ViSP's track() calls
   double measure_ms = 0.0;  // Track(): projection error read, moving-edge states, refinement,
-                            // covariance  // Track() with the sub-pixel refinement applied: its
-                            // edges and points (the measurements of the
+                            // covariance
+  // Track() with the sub-pixel refinement applied: its edges and points (the measurements of the
   // pose, for tracking/integrity/) and the edges it set aside.
   std::vector<EdgeObservation> observations;
   std::vector<EdgeObservation> set_aside;
