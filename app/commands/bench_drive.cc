@@ -6,9 +6,11 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -265,10 +267,17 @@ int RunBenchDrive(const BenchDriveOptions& opt) {
                     {"overall_fps", m.overall_fps},
                     {"odometry_drift_percent", reports.back().drift_percent}});
   }
+  double load[1] = {0.0};
+  const bool has_load = getloadavg(load, 1) == 1;
   if (opt.json) {
     std::cout << rows.dump(2) << std::endl;
   } else {
-    std::cout << FormatDriveTable(reports, opt.metrics) << details;
+    std::cout << FormatDriveTable(reports, opt.metrics);
+    if (has_load) {
+      std::cout << "\nReplay fps are wall-clock (load average " << std::fixed
+                << std::setprecision(1) << load[0] << " when the last replay ended).\n";
+    }
+    std::cout << details;
   }
   return kExitOk;
 }
