@@ -72,6 +72,7 @@ struct Drive {
     effects.blackouts = 1;
     effects.exposure_changes = 2;
     effects.shutter = 0.02;
+    effects.max_shutter_samples = 3;  // blur enough, and a fast test
     drive = std::make_unique<DriveRenderer>(model, renderer.get(), frames,
                                             PlanDriveEffects(frames, effects, &area), effects);
     for (int k = 0; k < kFrames; ++k) {
