@@ -15,6 +15,7 @@
 #include "models/geometry.h"
 #include "models/render/drive_renderer.h"
 #include "models/render/png.h"
+#include "models/statistics.h"
 
 namespace linetrack::app {
 namespace {
@@ -23,12 +24,6 @@ constexpr double kDriftWindowM = 10.0;  // metres of the odometry drift windows
 
 double Milliseconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // The camera file as ViSP writes it, placed atomically.
@@ -186,8 +181,8 @@ void WriteSequence(const std::string& out, const WireframeModel& model, SceneRen
                       SequenceJson(*sequence, observable).dump(2) + "\n");
   WriteCameraAtomically((dir / "camera.xml").string(), undistorted ? camera.Undistorted() : camera);
   std::cout << "wrote " << count << " frames (" << camera.width << "x" << camera.height << ") to "
-            << out << ": median " << std::fixed << std::setprecision(1) << Median(render_ms)
-            << " ms per frame to render and judge, " << Median(total_ms)
+            << out << ": median " << std::fixed << std::setprecision(1) << QuantileNearestRank(render_ms, 0.5)
+            << " ms per frame to render and judge, " << QuantileNearestRank(total_ms, 0.5)
             << " ms with PNG encoding and writing; " << observable << " observable; odometry drift "
             << std::setprecision(2) << 100.0 * sequence->drift.whole_share << " % over the run, "
             << 100.0 * sequence->drift.max_share << " % at most over " << kDriftWindowM << " m"
