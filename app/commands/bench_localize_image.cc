@@ -212,7 +212,7 @@ RenderedCaseOptions CaseOptions(const BenchLocalizeImageOptions& opt, const Prio
   case_options.calibration_sigma = opt.calibration_sigma;
   case_options.max_visible_edges = opt.max_edges;
   if (!opt.camera_path.empty()) {
-    case_options.camera = ReadCameraXml(opt.camera_path);
+    case_options.camera = LoadCamera(opt.camera_path);
     if (case_options.camera.width <= 0) {
       throw InputError(opt.camera_path + ": the camera file gives no image size");
     }
@@ -276,7 +276,8 @@ void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action) {
                   "Relative focal-length uncertainty the matcher allows (localize --focal-error)")
       ->capture_default_str();
   cmd->add_option("--camera", opt->camera_path,
-                  "Camera XML of the images (default: the paper's 640x480, px = 1000)");
+                  "Camera file of the images: ViSP XML, OpenCV or ROS YAML (default: the paper's "
+                  "640x480, px = 1000)");
   cmd->add_option("--max-edges", opt->max_edges,
                   "Views show 5 to this many model edges (synth's acceptance; wider lenses see "
                   "more)")

@@ -98,6 +98,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   if (!ParseHeadModel(opt.head_model, &plan.head_model)) {
     throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
   }
+  CheckHeight(opt.height, "--height");
   CheckRange(opt.height, 0.05, 100.0, "--height");
   plan.height = opt.height;
   if (!opt.prior.empty() && !opt.prior_file.empty()) {
@@ -226,7 +227,7 @@ class LiveFiles {
 
  private:
   static CameraIntrinsics ReadLiveCamera(const std::string& path) {
-    CameraIntrinsics camera = ReadCameraXml(path);
+    CameraIntrinsics camera = LoadCamera(path);
     if (camera.width <= 0) throw InputError(path + ": the camera file gives no image size");
     return camera;
   }
@@ -376,7 +377,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
       ->required();
   cmd->add_option("--head", opt->head, "ptu:/dev/ttyUSB0 | sim")->required();
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
-  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (with its image size)")
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (with its image size)")
       ->required();
   cmd->add_option("--height", opt->height, "Camera height above the floor, head level (metres)")
       ->required();
@@ -415,6 +417,10 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                   "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {
     opt->duration_given = cmd->get_option("--duration")->count() > 0;
+    RefuseUnless(*cmd, opt->estimator != "truth", {"--settings"},
+                 "the tracker's settings; --estimator truth uses no tracker");
+    RefuseUnless(*cmd, opt->source.rfind("aravis", 0) == 0, {"--camera-fps"},
+                 "sets the frame rate of an Aravis camera (--source aravis[:ID])");
     *action = [opt] { return RunLive(*opt); };
   });
 }

@@ -175,12 +175,12 @@ int RunRender(const RenderCommandOptions& opt) {
     throw InputError("--path: unknown path '" + opt.path + "' (known: hall-loop)");
   }
   const Pose3Dof planar = single ? ParsePrior(opt.pose, "--pose") : Pose3Dof();
-  CheckRange(opt.height, 0.0, 100.0, "--height");
+  CheckHeight(opt.height, "--height");
   CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   if (opt.frames < 0) throw InputError("--frames: must be >= 0");
   const RenderOptions render_options = ImageOptions(opt);
 
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
+  const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
   const WireframeModel model = WireframeModel::Load(opt.model_path);
@@ -256,7 +256,17 @@ void AddRender(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--supersample", opt->supersample, "Samples per pixel side (1-4)")
       ->capture_default_str();
   cmd->add_flag("--undistorted", opt->undistorted, "Ignore the camera's distortion");
-  cmd->callback([opt, action] { *action = [opt] { return RunRender(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnless(*cmd, opt->trajectory.empty(),
+                 {"--height", "--tilt", "--speed", "--fps", "--pan-amplitude", "--pan-period",
+                  "--tilt-amplitude", "--tilt-period", "--wall-distance"},
+                 "not with --trajectory (the file gives every frame's pose and time)");
+    RefuseUnless(*cmd, opt->pose.empty(),
+                 {"--frames", "--speed", "--fps", "--pan-amplitude", "--pan-period",
+                  "--tilt-amplitude", "--tilt-period", "--wall-distance"},
+                 "applies to a sequence (--trajectory or --path), not to one view (--pose)");
+    *action = [opt] { return RunRender(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

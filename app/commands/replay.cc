@@ -32,7 +32,8 @@ using Clock = std::chrono::steady_clock;
 
 struct ReplayOptions {
   std::string input, model, camera, prior_file, prior, init_pose, settings, ground_truth, out;
-  double height = std::nan(""), tilt_deg = std::nan("");
+  double height = 0.0, tilt_deg = 0.0;
+  bool has_height = false, has_tilt = false;  // --height, --tilt given
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
   double fps = 0.0;
@@ -105,16 +106,16 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   if (has_prior && !opt.prior_file.empty()) {
     throw InputError("replay: give either --prior-file or --prior, not both");
   }
-  const bool has_height_tilt = std::isfinite(opt.height) || std::isfinite(opt.tilt_deg);
-  if ((has_prior || has_height_tilt) &&
-      !(std::isfinite(opt.height) && std::isfinite(opt.tilt_deg))) {
-    throw InputError("replay: --prior needs both --height and --tilt");
+  const bool has_height_tilt = opt.has_height || opt.has_tilt;
+  if ((has_prior || has_height_tilt) && !(opt.has_height && opt.has_tilt)) {
+    throw InputError(has_prior ? "replay: --prior needs both --height and --tilt"
+                               : "replay: --height and --tilt go together");
   }
   if (!has_prior && opt.prior_file.empty() && opt.init_pose.empty()) {
     throw InputError("replay: nothing to start from: give --init-pose, --prior-file or --prior");
   }
   if (has_height_tilt) {
-    CheckRange(opt.height, 0.0, 100.0, "--height");
+    CheckHeight(opt.height, "--height");
     CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   }
   CheckRange(opt.delta_t, 0.0, 100.0, "--delta-t");
@@ -124,7 +125,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   if (has_prior) s.initial_prior = ParsePrior(opt.prior, "--prior");
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
-  s.camera = ReadCameraXml(opt.camera);
+  s.camera = LoadCamera(opt.camera);
   TrackerSettings base;
   base.visibility.scanline = opt.scanline;
   s.settings = opt.settings.empty() ? base : ReadTrackerSettings(opt.settings, base);
@@ -434,7 +435,8 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--input", opt->input, "Video file or printf image pattern 'DIR/frame_%05d.png'")
       ->required();
   cmd->add_option("--model", opt->model, "ViSP .cao model")->required();
-  cmd->add_option("--camera", opt->camera, "ViSP camera XML (its distortion is undone)")
+  cmd->add_option("--camera", opt->camera,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (its distortion is undone)")
       ->required();
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option("--prior-file", opt->prior_file,
@@ -463,7 +465,21 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   cmd->add_flag("--scanline", opt->scanline,
                 "Scan-line visibility (hidden edge parts not tracked; about 4x slower)");
-  cmd->callback([opt, action] { *action = [opt] { return RunReplay(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    opt->has_height = cmd->count("--height") > 0;
+    opt->has_tilt = cmd->count("--tilt") > 0;
+    const bool robot = opt->has_height || opt->has_tilt || cmd->count("--prior") > 0 ||
+                       cmd->count("--prior-file") > 0;
+    RefuseUnless(*cmd, cmd->count("--prior-file") == 0, {"--height", "--tilt"},
+                 "not with --prior-file (it gives each frame's height and tilt)");
+    RefuseUnless(*cmd, robot,
+                 {"--delta-t", "--delta-phi", "--detector", "--min-length", "--roi", "--no-merge",
+                  "--undistort"},
+                 "applies to the matcher, which needs a robot's readings (--prior-file, or "
+                 "--prior with --height and --tilt)");
+    RefuseUnless(*cmd, !opt->no_overlay, {"--overlay-png"}, "not with --no-overlay");
+    *action = [opt] { return RunReplay(*opt); };
+  });
 }
 
 }  // namespace linetrack::app
