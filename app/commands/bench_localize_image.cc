@@ -16,10 +16,11 @@
 #include "app/localize_image.h"
 #include "app/match_outcome.h"
 #include "app/rendered_cases.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
+#include "models/statistics.h"
 #include "models/view_invariant_regions.h"
 
 namespace linetrack::app {
@@ -74,12 +75,6 @@ Outcome Judge(const RenderedCase& c, const LocalizationResult& result,
       });
   return JudgeMatch(result.found, all_true,
                     ErrorsOf(result.pose.Planar(), result.covariance, c.scene.truth.Planar()));
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
 LocalizationProblem Problem(const RenderedCase& c, std::vector<Segment2> lines) {
@@ -186,12 +181,13 @@ std::string ImageTable(const BenchLocalizeImageOptions& opt, const PriorBounds& 
         << "| " << t.counts[0] << " (" << std::setprecision(1) << 100.0 * t.counts[0] / n
         << " %) | " << t.counts[1] << " | " << t.counts[2] << " | " << t.counts[3] << " | "
         << t.accurate << " (" << 100.0 * t.accurate / n << " %) | " << std::setprecision(2)
-        << Quantile(t.lines_ms, 0.5) << " / " << Quantile(t.lines_ms, 0.9) << " | "
-        << Quantile(t.matcher_ms, 0.5) << " / " << Quantile(t.matcher_ms, 0.9) << " | "
-        << Quantile(t.total_ms, 0.5) << " / " << Quantile(t.total_ms, 0.9) << " | "
-        << std::setprecision(0) << Quantile(t.segments, 0.5) << " | " << std::setprecision(3)
-        << Quantile(t.position_error, 0.5) << " m, " << std::setprecision(2)
-        << Quantile(t.heading_error, 0.5) << " deg |\n\n"
+        << QuantileNearestRank(t.lines_ms, 0.5) << " / " << QuantileNearestRank(t.lines_ms, 0.9)
+        << " | " << QuantileNearestRank(t.matcher_ms, 0.5) << " / "
+        << QuantileNearestRank(t.matcher_ms, 0.9) << " | " << QuantileNearestRank(t.total_ms, 0.5)
+        << " / " << QuantileNearestRank(t.total_ms, 0.9) << " | " << std::setprecision(0)
+        << QuantileNearestRank(t.segments, 0.5) << " | " << std::setprecision(3)
+        << QuantileNearestRank(t.position_error, 0.5) << " m, " << std::setprecision(2)
+        << QuantileNearestRank(t.heading_error, 0.5) << " deg |\n\n"
         << "Not correct: " << t.causes[0] + t.causes[1] + t.causes[2]
         << "; by cause: " << t.causes[0] << " " << kCauseNames[0] << ", " << t.causes[1] << " "
         << kCauseNames[1] << ", " << t.causes[2] << " " << kCauseNames[2] << ".\n";
