@@ -104,7 +104,7 @@ PoseRefinementResult Refit(const VerificationContext& context, const Verificatio
                            double scale) {
   auto refine = [&] {
     return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                      start, scale, RefinementOptions(context, options));
+                      PoseAndScale{start, scale}, RefinementOptions(context, options));
   };
   if (context.consensus_memo == nullptr) return refine();
   ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
@@ -138,9 +138,9 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
     double worst_chi2 = -1.0;
     for (size_t i = 0; i < matches.size(); ++i) {
       const double chi2 =
-          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                    context.tilt, hypothesis->pose,
-                                                    hypothesis->refinement.focal_scale, nullptr))
+          (matches[i].whitening *
+           EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                             {hypothesis->pose, hypothesis->refinement.focal_scale}, nullptr))
               .squaredNorm();
       if (chi2 > worst_chi2) {
         worst_chi2 = chi2;
@@ -162,9 +162,9 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
         continue;
       }
       const double chi2 =
-          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                    context.tilt, hypothesis->pose,
-                                                    hypothesis->refinement.focal_scale, nullptr))
+          (matches[i].whitening *
+           EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                             {hypothesis->pose, hypothesis->refinement.focal_scale}, nullptr))
               .squaredNorm();
       if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
     }
@@ -190,9 +190,9 @@ int OutlyingPair(const VerificationContext& context, const VerificationOptions& 
   for (size_t i = 0; i < matches.size(); ++i) {
     Eigen::Matrix<double, 2, 4> j;
     const Eigen::Vector2d r =
-        matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                 context.tilt, hypothesis.pose,
-                                                 hypothesis.refinement.focal_scale, &j);
+        matches[i].whitening *
+        EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                          {hypothesis.pose, hypothesis.refinement.focal_scale}, &j);
     const Eigen::Matrix<double, 2, 4> wj = matches[i].whitening * j;
     const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
     // A leverage near 1 (the pair alone fixes a direction of the pose) cannot be tested.
@@ -213,7 +213,7 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
   Eigen::Matrix<double, 2, 4> j;
   const Eigen::Vector2d r =
       match.whitening * EndpointResiduals(match, *context.camera, context.height, context.tilt,
-                                          verified.pose, verified.refinement.focal_scale, &j);
+                                          {verified.pose, verified.refinement.focal_scale}, &j);
   const Eigen::Matrix<double, 2, 4> wj = match.whitening * j;
   const Eigen::Matrix4d& c = verified.refinement.bounded_covariance;
   const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
@@ -246,8 +246,8 @@ PoseRefinementResult VouchedRefinement(const VerificationContext& context,
       continue;
     }
     Eigen::Matrix<double, 2, 4> j;
-    EndpointResiduals(matches[i], *context.camera, context.height, context.tilt, verified.pose,
-                      verified.refinement.focal_scale, &j);
+    EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                      {verified.pose, verified.refinement.focal_scale}, &j);
     const Eigen::Matrix<double, 2, 4> wj = matches[i].whitening * j;
     const Eigen::Matrix2d leverage = wj * c * wj.transpose();
     // The variance along the worst direction grows by 1 / (1 - largest eigenvalue) without it.
@@ -261,8 +261,9 @@ PoseRefinementResult VouchedRefinement(const VerificationContext& context,
   if (kept.size() == matches.size()) return verified.refinement;
   // Refitted under the same cost as the verification (the prior's bounds included), so the kept
   // pairs cannot slide out of the prior; the result's covariance is the image information alone.
-  return RefinePose(kept, *context.camera, context.height, context.tilt, verified.pose,
-                    verified.refinement.focal_scale, RefinementOptions(context, options));
+  return RefinePose(kept, *context.camera, context.height, context.tilt,
+                    {verified.pose, verified.refinement.focal_scale},
+                    RefinementOptions(context, options));
 }
 
 std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,

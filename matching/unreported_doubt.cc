@@ -51,9 +51,9 @@ bool DeletedGroupPose(const VerificationContext& context, const VerifiedPose& ve
   for (size_t k = 0; k < matches.size(); ++k) {
     Eigen::Matrix<double, 2, 4> jk;
     r.segment<2>(2 * k) =
-        matches[k].whitening * EndpointResiduals(matches[k], *context.camera, context.height,
-                                                 context.tilt, verified.pose,
-                                                 verified.refinement.focal_scale, &jk);
+        matches[k].whitening *
+        EndpointResiduals(matches[k], *context.camera, context.height, context.tilt,
+                          {verified.pose, verified.refinement.focal_scale}, &jk);
     j.middleRows<2>(2 * k) = matches[k].whitening * jk;
   }
   const Eigen::Matrix4d& c = verified.refinement.covariance;

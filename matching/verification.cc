@@ -272,9 +272,9 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
     std::vector<std::pair<int, int>> pairs = Pairs(assignment);
     std::sort(pairs.begin(), pairs.end());
     if (pairs == previous || round == options.guided_rounds || pairs.size() < 2) break;
-    result.refinement =
-        RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                   result.pose, result.refinement.focal_scale, RefinementOptions(context, options));
+    result.refinement = RefinePose(ToLineMatches(context, pairs), *context.camera, context.height,
+                                   context.tilt, {result.pose, result.refinement.focal_scale},
+                                   RefinementOptions(context, options));
     result.pose = result.refinement.pose;
     previous = std::move(pairs);
   }

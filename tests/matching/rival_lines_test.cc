@@ -165,8 +165,9 @@ TEST_F(RivalLinesTest, AStandInForAnUndetectedImageIsNotReportedAtThePoseOfTheOt
     Eigen::Matrix4d covariance;
     ASSERT_TRUE(DeletedPose(exact, truth, index, &others, &covariance));
     Eigen::Matrix<double, 3, 4> d_line;
-    ProjectedEdgeLine(edges_[edge].a, edges_[edge].b, camera_, scene.height, scene.tilt, others,
-                      truth.refinement.focal_scale, &d_line);
+    ProjectedEdgeLine(edges_[edge].a, edges_[edge].b, camera_,
+                      ViewOf(others, scene.height, scene.tilt), truth.refinement.focal_scale,
+                      &d_line);
     const Eigen::Vector2d mid = scene.lines[line].Mid();
     const Eigen::RowVector4d j = Eigen::Vector3d(mid.x(), mid.y(), 1.0).transpose() * d_line;
     const double sigma_px =
