@@ -7,6 +7,9 @@
 #include <numeric>
 #include <set>
 
+#include "matching/hypothesis_trimming.h"
+#include "matching/pose_decision.h"
+#include "matching/reported_pairs.h"
 #include "matching/unreported_doubt.h"
 #include "models/errors.h"
 
@@ -156,10 +159,9 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     double best = -std::numeric_limits<double>::infinity();
     std::vector<std::vector<std::pair<int, int>>> verified_pairs;
     std::vector<VerifiedBasin> basins;
-    long pair_tests = 0;
-    context.pair_tests = &pair_tests;
+    VerificationStats verification_stats;
+    long& pair_tests = verification_stats.pair_tests;
     ConsensusMemo consensus_memo;
-    context.consensus_memo = &consensus_memo;
     // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
     std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched;
     const LeafVisitor visit = [&](const Hypothesis& h) {
@@ -190,7 +192,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       }
       ++result.hypotheses;
       VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
-      if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
+      if (!TrimHypothesis(context, vo, &leaf, &consensus_memo) ||
+          HypothesisEvidence(context, vo, leaf) < bound) {
         return bound;
       }
       // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
@@ -204,7 +207,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
         return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
       }
       const long tests_before = pair_tests;
-      VerifiedPose v = Rematch(context, leaf, vo);
+      VerifiedPose v = Rematch(context, leaf, vo, &verification_stats);
       known.push_back({leaf.pose, leaf.refinement.focal_scale, pair_tests - tests_before});
       if (v.plausible) {
         CompleteEvidence(context, vo, &v);
@@ -236,8 +239,6 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
       SearchUnsearchedRootBranches(edges, lines, prior, caps, stats.unsearched, visit, &basins,
                                    &pair_tests, &result);
     }
-    context.pair_tests = nullptr;
-    context.consensus_memo = nullptr;
   } else {
     BaselineStats stats;
     verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);

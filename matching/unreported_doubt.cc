@@ -9,7 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "matching/verification_internal.h"
+#include "matching/reported_pairs.h"
 
 namespace linetrack {
 
@@ -138,8 +138,7 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     // for itself); which edges are in view, over which stretch and unhidden, from the pose where
     // the pairs were found (a small shift must not push a seen edge out of the frame).
     ExplainFrom from;
-    from.seen = &verified.pose;
-    from.seen_scale = verified.refinement.focal_scale;
+    from.seen = PoseAndScale{verified.pose, verified.refinement.focal_scale};
     from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
     // A rival line held by another edge of the interpretation is that pair undone, not free.
     from.held = &verified.pairs;
@@ -148,7 +147,7 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
       log_true += LogProbabilityTrue(
-          ExplainPair(context, options, pose, scale, group.covariance, pair, from));
+          ExplainPair(context, options, {pose, scale}, group.covariance, pair, from));
     }
     group.probability_true = std::exp(log_true);
     const double doubt = 1.0 - group.probability_true;

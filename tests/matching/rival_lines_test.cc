@@ -9,7 +9,9 @@
 #include <limits>
 #include <numeric>
 
+#include "matching/hypothesis_trimming.h"
 #include "matching/pose_refinement.h"
+#include "matching/reported_pairs.h"
 #include "matching/verification.h"
 #include "models/synthetic_scenes.h"
 

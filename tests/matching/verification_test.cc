@@ -12,6 +12,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "matching/hypothesis_trimming.h"
+#include "matching/pose_decision.h"
 #include "matching/unreported_doubt.h"
 #include "models/synthetic_scenes.h"
 
@@ -152,10 +154,10 @@ TEST_F(VerificationTest, ConsensusMemoGivesTheSameTrimmedHypothesis) {
     VerifiedPose plain = start;
     const bool plain_ok = TrimHypothesis(context, options_, &plain);
     ConsensusMemo memo;
-    context.consensus_memo = &memo;
     for (int pass = 0; pass < 2; ++pass) {  // the memo filled, then read
       VerifiedPose memoised = start;
-      EXPECT_EQ(TrimHypothesis(context, options_, &memoised), plain_ok) << "scene " << scene.index;
+      EXPECT_EQ(TrimHypothesis(context, options_, &memoised, &memo), plain_ok)
+          << "scene " << scene.index;
       EXPECT_EQ(memoised.pairs, plain.pairs) << "scene " << scene.index;
       EXPECT_EQ(memoised.pose.x, plain.pose.x) << "scene " << scene.index;
       EXPECT_EQ(memoised.pose.y, plain.pose.y) << "scene " << scene.index;

@@ -1,0 +1,48 @@
+// The decision among verified poses: which one is the answer (ranking, ambiguity, the evidence
+// a pose needs), the rivals a pose hinging on one correspondence has, and the pairs its
+// covariance leans on.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "matching/verification.h"
+
+namespace linetrack {
+
+// The evidence (nats) a verified pose needs not to be a chance alignment: chance_nats plus
+// ln(V_prior / V_pose), V_prior = pi delta_t^2 2 delta_phi the prior's volume in (x, y, heading)
+// and V_pose = (2 pi)^(3/2) sqrt(det C) the pose's (C its covariance): the number of distinct
+// poses the search could have found by chance.
+double RequiredEvidence(const VerificationContext& context, const VerificationOptions& options,
+                        const VerifiedPose& verified);
+
+// Orders verified poses: plausible first, then the larger evidence.
+bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
+
+// True when two poses are the same answer (within same_pose_m and same_pose_deg).
+bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options);
+
+// The refinement of a verified pose over the pairs it can lean on: `reported` (its reported
+// correspondences) and those of its other pairs whose leverage at its pose (largest eigenvalue of
+// W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
+// high-leverage unreported pairs left out at once); its own refinement when none is left out. An
+// unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
+// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107). `kept`,
+// when given, receives the pairs of the refinement.
+PoseRefinementResult VouchedRefinement(const VerificationContext& context,
+                                       const VerificationOptions& options,
+                                       const VerifiedPose& verified,
+                                       const std::vector<std::pair<int, int>>& reported,
+                                       std::vector<std::pair<int, int>>* kept = nullptr);
+
+// The poses a verified pose's pairs give without one of its influential pairs (the first-order
+// deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
+// hypothesis_quantile of chi2(3)), each refined and verified by Rematch without that pair
+// (evidence lines term only). A pose that hinges on one correspondence has the pose of the
+// others as a rival explanation, which the tree does not verify (a subset of a verified leaf).
+std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
+                                            const VerificationOptions& options,
+                                            const VerifiedPose& verified);
+
+}  // namespace linetrack
