@@ -131,32 +131,6 @@ class Localizer {
   const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
-  // An exhausted search may have missed the pose that explains the lines its best pose leaves
-  // unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the
-  // tree is searched again over those lines alone, with fresh budgets, its leaves handed to
-  // `visit` (which verifies them against all lines); when that finds nothing better, over the
-  // lines it does not explain with a reported correspondence.
-  void SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const std::vector<double>& caps,
-                              const std::vector<VerifiedPose>& verified, const LeafVisitor& visit,
-                              long* pair_tests, LocalizationResult* result) const;
-
-  // Searches the root branches `branches` the exhausted main search did not reach, with
-  // unsearched_branches_share of its budgets (a fresh share of the pair tests), its leaves handed
-  // to `visit`.
-  void SearchUnsearchedRootBranches(const std::vector<MatchEdge>& edges,
-                                    const std::vector<ObservedLine>& lines,
-                                    const PriorRegion& prior, const std::vector<double>& caps,
-                                    const UnsearchedBranches& branches, const LeafVisitor& visit,
-                                    const std::vector<VerifiedBasin>* basins, long* pair_tests,
-                                    LocalizationResult* result) const;
-
-  // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
-  // and support checks) and fills `result`.
-  void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
-              const std::vector<MatchEdge>& edges, LocalizationResult* result) const;
-
   const WireframeModel& model_;
   const ViewInvariantRegions* regions_;
   const NavigableArea* area_;

@@ -98,4 +98,94 @@ std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
   return rivals;
 }
 
+bool RankPoses(const VerificationContext& context, const VerificationOptions& options,
+               std::vector<VerifiedPose>* verified, std::string* why) {
+  if (verified->empty()) {
+    *why = "no consistent hypothesis";
+    return false;
+  }
+  for (VerifiedPose& v : *verified) {
+    if (v.plausible) CompleteEvidence(context, options, &v);
+  }
+  std::stable_sort(verified->begin(), verified->end(), BetterThan);
+  if (!verified->front().plausible) {
+    *why = "no plausible pose (best: " + verified->front().implausible_because + ")";
+    return false;
+  }
+  // The best pose's rivals hidden by one of its correspondences join the comparison.
+  for (VerifiedPose& rival : LeaveOneOutRivals(context, options, verified->front())) {
+    if (rival.plausible) CompleteEvidence(context, options, &rival);
+    verified->push_back(std::move(rival));
+  }
+  std::stable_sort(verified->begin(), verified->end(), BetterThan);
+  return true;
+}
+
+std::vector<size_t> DistinctPoses(const std::vector<VerifiedPose>& ranked,
+                                  const VerificationOptions& options) {
+  std::vector<size_t> distinct = {0};
+  std::vector<Pose3Dof> poses = {ranked.front().pose};
+  for (size_t i = 0; i < ranked.size(); ++i) {
+    const VerifiedPose& v = ranked[i];
+    if (!v.plausible) break;
+    if (std::any_of(poses.begin(), poses.end(),
+                    [&](const Pose3Dof& d) { return SamePose(d, v.pose, options); })) {
+      continue;
+    }
+    poses.push_back(v.pose);
+    distinct.push_back(i);
+  }
+  return distinct;
+}
+
+bool ClearlyBest(const VerificationContext& context, const VerificationOptions& options,
+                 const std::vector<size_t>& distinct, std::vector<VerifiedPose>* ranked,
+                 std::string* why) {
+  const VerifiedPose& best = ranked->front();
+  const double score = best.evidence.Score();
+  if (distinct.size() > 1 &&
+      score - (*ranked)[distinct[1]].evidence.Score() < options.ambiguity_nats) {
+    *why = "ambiguous: another pose explains the image almost as well";
+    return false;
+  }
+  // An unobservable pose inside the prior (or one held at its border) is a rival explanation
+  // too: when a distinct one comes within the margin, the accepted pose is not clearly the best
+  // explanation of the lines.
+  for (VerifiedPose& v : *ranked) {
+    if (!v.unobservable || v.evidence.lines_nats < score - options.ambiguity_nats ||
+        SamePose(v.pose, best.pose, options)) {
+      continue;  // the edges term is not positive: lines_nats bounds the evidence
+    }
+    CompleteEvidence(context, options, &v);
+    if (v.evidence.Score() > score - options.ambiguity_nats) {
+      *why = "ambiguous: " +
+             std::string(v.implausible_because == "unobservable"
+                             ? "an unobservable pose"
+                             : "a pose held at the prior's border") +
+             " explains the image almost as well";
+      return false;
+    }
+  }
+  return true;
+}
+
+Eigen::Matrix4d AnswerCovariance(const VerificationContext& context,
+                                 const VerificationOptions& options, const VerifiedPose& best,
+                                 const std::vector<std::pair<int, int>>& reported,
+                                 std::vector<DoubtedGroup>* groups) {
+  // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
+  // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
+  VerifiedPose vouched = best;
+  vouched.refinement = VouchedRefinement(context, options, best, reported, &vouched.pairs);
+  vouched.pose = vouched.refinement.pose;
+  const bool observable =
+      vouched.refinement.position_sigma_m <= options.max_position_sigma_m &&
+      vouched.refinement.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  const VerifiedPose& base = observable ? vouched : best;
+  // And it averages over what the unreported pairs it keeps are (true or clutter).
+  return options.doubt_unreported_pairs
+             ? DoubtedCovariance(context, options, base, reported, groups)
+             : base.refinement.covariance;
+}
+
 }  // namespace linetrack

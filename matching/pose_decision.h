@@ -3,9 +3,11 @@
 // covariance leans on.
 #pragma once
 
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "matching/unreported_doubt.h"
 #include "matching/verification.h"
 
 namespace linetrack {
@@ -44,5 +46,35 @@ PoseRefinementResult VouchedRefinement(const VerificationContext& context,
 std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
                                             const VerificationOptions& options,
                                             const VerifiedPose& verified);
+
+// The decision's steps, in the order the localizer takes them.
+
+// Ranks verified poses for the decision (BetterThan), the plausible ones' evidence completed,
+// with the leave-one-out rivals of the best joining them. False, with the reason, when there is
+// no pose or no plausible one.
+bool RankPoses(const VerificationContext& context, const VerificationOptions& options,
+               std::vector<VerifiedPose>* verified, std::string* why);
+
+// The distinct plausible poses of ranked verified poses, best first: each the best of the poses
+// SamePose as it (indices into `ranked`, which is not empty).
+std::vector<size_t> DistinctPoses(const std::vector<VerifiedPose>& ranked,
+                                  const VerificationOptions& options);
+
+// True when the best of ranked poses (`ranked` front, `distinct` from DistinctPoses) explains
+// the lines clearly better than every other distinct pose: by ambiguity_nats over the second
+// distinct plausible pose and over every distinct unobservable one (plausible but for its
+// observability or held at the prior's border, whose evidence this completes). Else the reason.
+bool ClearlyBest(const VerificationContext& context, const VerificationOptions& options,
+                 const std::vector<size_t>& distinct, std::vector<VerifiedPose>* ranked,
+                 std::string* why);
+
+// The accepted pose's covariance (heading, x, y, scale): that of the pairs it can lean on
+// (VouchedRefinement; its own when they leave the pose unobservable), averaged over what its
+// unreported pairs are when options.doubt_unreported_pairs (DoubtedCovariance, whose groups
+// `groups` receives).
+Eigen::Matrix4d AnswerCovariance(const VerificationContext& context,
+                                 const VerificationOptions& options, const VerifiedPose& best,
+                                 const std::vector<std::pair<int, int>>& reported,
+                                 std::vector<DoubtedGroup>* groups);
 
 }  // namespace linetrack
