@@ -20,7 +20,8 @@ void NonVerticalResiduals(const ObservedLine& line, const MatchEdge& edge, doubl
   const Eigen::Vector3d p = ObservedPointOnEdge(line, edge, height, truth.heading, at);
   const Eigen::Vector3d l = PositionLine(line.normal, p, height, truth.heading);
   check->second_sigmas =
-      DistanceToLine(l, at) / PositionBandHalfWidth(line, p, height, truth.heading, at, 1.0);
+      DistanceToLine(l, at) /
+      PositionBandHalfWidth(line, p, Eigen::Vector3d(at.x(), at.y(), height), truth.heading, 1.0);
 }
 
 void VerticalResiduals(const ObservedLine& line, const MatchEdge& edge, const Pose3Dof& truth,
@@ -75,19 +76,17 @@ class TruthDiagnoser {
         problem_(problem),
         truth_(truth),
         options_(localizer.options()),
-        camera_(localizer.camera()) {
+        camera_(localizer.camera()),
+        prior_(localizer.Prior(problem)) {
     const std::vector<int> ids = localizer.CandidateEdges(problem);
     edges_ = PrepareEdges(localizer.model(), ids);
     for (size_t i = 0; i < ids.size(); ++i)
       index_of_edge_[ids[i]] = static_cast<int>(i);
     lines_ = PrepareLines(problem.lines, camera_, problem.tilt, options_.noise,
                           options_.tree.vertical_gate_sigmas);
-    prior_heading_ = {problem.prior.heading - problem.delta_phi,
-                      problem.prior.heading + problem.delta_phi};
-    centre_ = {problem.prior.x, problem.prior.y};
     gate_.sigmas = options_.tree.gate_sigmas;
     gate_.extent_slack_px = options_.tree.extent_slack_px;
-    gate_.focal_px = 0.5 * (camera_.px + camera_.py);
+    gate_.focal_px = prior_.focal_px;
   }
 
   // Each true correspondence through the candidate edges and the unary constraints, and the
@@ -125,8 +124,8 @@ class TruthDiagnoser {
     const InterpretationTreeOptions& tree = options_.tree;
     const double min_width = DegToRad(tree.heading_bin_deg);
     FeasibleRegion region =
-        FeasibleRegion::FromPrior(prior_heading_, centre_, problem_.delta_t,
-                                  std::max(min_width, prior_heading_.Width() / tree.max_bins));
+        FeasibleRegion::FromPrior(prior_.heading, prior_.centre, prior_.radius,
+                                  std::max(min_width, prior_.heading.Width() / tree.max_bins));
     out->region_consistent = true;
     for (const auto& [e, l] : pairs) {
       const bool kept =
@@ -146,15 +145,9 @@ class TruthDiagnoser {
   // All true correspondences verified as the matcher verifies a hypothesis, from the true pose.
   void VerifyTruth(const std::vector<std::pair<int, int>>& truth_matches,
                    TruthDiagnosis* out) const {
-    PriorRegion prior;
-    prior.centre = centre_;
-    prior.radius = problem_.delta_t;
-    prior.heading = prior_heading_;
-    prior.height = problem_.height;
-    prior.focal_px = gate_.focal_px;
     const VerificationContext context{&edges_,         &lines_,           &camera_,
                                       problem_.height, problem_.tilt,     &localizer_.occlusion(),
-                                      &prior,          localizer_.area(), options_.noise};
+                                      &prior_,         localizer_.area(), options_.noise};
     VerificationOptions vo = options_.verification;
     if (vo.refinement.focal_prior_sigma == 0.0) {
       vo.refinement.focal_prior_sigma = options_.noise.focal_relative;
@@ -207,14 +200,10 @@ class TruthDiagnoser {
       check.vertical_line = line.maybe_vertical;
       VerticalResiduals(line, edge, truth_, &check);
       check.unary_pass =
-          line.maybe_vertical && UnaryVertical(line, edge, problem_.height, prior_heading_, centre_,
-                                               problem_.delta_t, gate_)
-                                     .has_value();
+          line.maybe_vertical && UnaryVertical(line, edge, prior_, gate_).has_value();
     } else {
       NonVerticalResiduals(line, edge, problem_.height, truth_, &check);
-      check.unary_pass = !UnaryNonVertical(line, edge, problem_.height, prior_heading_, centre_,
-                                           problem_.delta_t, gate_)
-                              .empty();
+      check.unary_pass = !UnaryNonVertical(line, edge, prior_, gate_).empty();
     }
     return check;
   }
@@ -227,8 +216,7 @@ class TruthDiagnoser {
   std::vector<MatchEdge> edges_;
   std::map<int, int> index_of_edge_;  // model edge id -> index into edges_
   std::vector<ObservedLine> lines_;
-  HeadingInterval prior_heading_;
-  Eigen::Vector2d centre_;
+  const PriorRegion prior_;
   Gate gate_;
   std::map<int, int> hypothesis_;  // candidate edge index -> the truth's line for it
 };

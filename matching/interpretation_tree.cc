@@ -27,21 +27,22 @@ namespace {
 // line left unexplained removes its cap from the bound at once.
 class TreeSearch {
  public:
-  TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
-             const PriorRegion& prior, const InterpretationTreeOptions& options,
-             const std::vector<double>& line_caps, const LeafVisitor& visit,
-             InterpretationTreeStats* stats, const std::vector<VerifiedBasin>* basins)
-      : edges_(edges),
-        lines_(lines),
-        prior_(prior),
+  TreeSearch(const TreeProblem& problem, const InterpretationTreeOptions& options,
+             const LeafVisitor& visit, InterpretationTreeStats* stats,
+             const std::vector<VerifiedBasin>* basins)
+      : edges_(*problem.edges),
+        lines_(*problem.lines),
+        prior_(*problem.prior),
         options_(options),
         visit_(visit),
         stats_(stats),
         basins_(basins) {
     gate_.sigmas = options.gate_sigmas;
     gate_.extent_slack_px = options.extent_slack_px;
-    gate_.focal_px = prior.focal_px;
-    caps_ = line_caps.empty() ? std::vector<double>(lines.size(), 1.0) : line_caps;
+    gate_.focal_px = prior_.focal_px;
+    caps_ = problem.line_caps == nullptr || problem.line_caps->empty()
+                ? std::vector<double>(lines_.size(), 1.0)
+                : *problem.line_caps;
   }
 
   // Builds the candidates and the root region; false when there is nothing to search.
@@ -156,13 +157,9 @@ class TreeSearch {
         bool pass = false;
         if (edges_[e].vertical) {
           pass = lines_[j].maybe_vertical &&
-                 UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                               prior_.radius, gate_)
-                     .has_value();
+                 UnaryVertical(lines_[j], edges_[e], prior_, gate_).has_value();
         } else {
-          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
-                                   prior_.centre, prior_.radius, gate_)
-                      .empty();
+          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_, gate_).empty();
         }
         if (!pass) continue;
         candidate_edge_.push_back(static_cast<int>(e));
@@ -499,25 +496,19 @@ bool InterpretationTreeOptions::Check(std::string* why) const {
   return true;
 }
 
-void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats,
+void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTreeOptions& options,
+                              const LeafVisitor& visit, InterpretationTreeStats* stats,
                               const std::vector<VerifiedBasin>* basins) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Run();
+  TreeSearch(problem, options, visit, stats, basins).Run();
 }
 
-void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps,
+void SearchUnsearchedBranches(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
                               const std::vector<VerifiedBasin>* basins) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Resume(branches);
+  TreeSearch(problem, options, visit, stats, basins).Resume(branches);
 }
 
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
@@ -527,7 +518,7 @@ std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            InterpretationTreeStats* stats) {
   std::vector<Hypothesis> leaves;
   SearchInterpretationTree(
-      edges, lines, prior, options, {},
+      {&edges, &lines, &prior, nullptr}, options,
       [&](const Hypothesis& h) {
         leaves.push_back(h);
         return 0.0;

@@ -45,18 +45,6 @@ struct InterpretationTreeOptions {
   bool Check(std::string* why) const;
 };
 
-// The prior: disk of positions and interval of headings, at known height (metres).
-struct PriorRegion {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  double radius = 0.0;
-  HeadingInterval heading;
-  double height = 0.0;
-  double focal_px = 1000.0;  // mean focal length of the camera (pixels)
-  // When set, camera positions lie in this box (the navigable area's bounds).
-  bool has_bounds = false;
-  Eigen::Vector2d bounds_min = Eigen::Vector2d::Zero(), bounds_max = Eigen::Vector2d::Zero();
-};
-
 // A leaf: (edge index, line index) pairs into the given edge and line lists, and the pose region
 // the correspondences share.
 struct Hypothesis {
@@ -113,30 +101,33 @@ struct InterpretationTreeStats {
   UnsearchedBranches unsearched;  // set when the budget stopped the root's first branch
 };
 
+// What the tree searches: the candidate edges and the image lines (leaves' pairs index into
+// them), the prior region, and each line's cap (nats; null or empty: 1 per line, so that bounds
+// count lines).
+struct TreeProblem {
+  const std::vector<MatchEdge>* edges = nullptr;
+  const std::vector<ObservedLine>* lines = nullptr;
+  const PriorRegion* prior = nullptr;
+  const std::vector<double>* line_caps = nullptr;
+};
+
 // Called on leaves in search order, each distinct leaf once, when its bound reaches the current
 // one. Returns the smallest bound still worth exploring (the best evidence found less the
 // ambiguity margin); return 0 to keep the current one.
 using LeafVisitor = std::function<double(const Hypothesis&)>;
 
-// Searches the tree depth first, assignments (longest lines first) before skips. `line_caps`
-// holds each line's cap (nats); empty means 1 per line (bounds count lines). `basins` (may be
-// null; the visitor may add to it) are read at every node. Deterministic: the same input gives
-// the same leaves in the same order.
-void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats,
+// Searches the tree depth first, assignments (lines by decreasing cap) before skips. `basins`
+// (may be null; the visitor may add to it) are read at every node. Deterministic: the same input
+// gives the same leaves in the same order.
+void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTreeOptions& options,
+                              const LeafVisitor& visit, InterpretationTreeStats* stats,
                               const std::vector<VerifiedBasin>* basins = nullptr);
 
-// Searches the root branches an exhausted search (same edges, lines, prior and caps) did not
-// reach, at the bound of the pass it stopped in, each with an equal share of the options'
-// budgets; leaves as SearchInterpretationTree. `stats->budget_exhausted` stays set (the pass
-// is still not complete).
-void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps,
+// Searches the root branches an exhausted search of the same problem did not reach, at the
+// bound of the pass it stopped in, each with an equal share of the options' budgets; leaves as
+// SearchInterpretationTree. `stats->budget_exhausted` stays set (the pass is still not
+// complete).
+void SearchUnsearchedBranches(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
                               const std::vector<VerifiedBasin>* basins = nullptr);

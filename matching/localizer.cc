@@ -289,7 +289,7 @@ void SearchUnexplainedLines(const VerificationContext& context, const LocalizerO
     leaves->GiveBudgetShare(share);
     InterpretationTreeStats stats;
     SearchInterpretationTree(
-        *context.edges, rest, *context.prior, WithBudgetShare(options.tree, share), rest_caps,
+        {context.edges, &rest, context.prior, &rest_caps}, WithBudgetShare(options.tree, share),
         [&](const Hypothesis& h) {
           Hypothesis full = h;
           for (auto& pair : full.pairs)
@@ -315,7 +315,7 @@ void SearchUnsearchedRootBranches(const VerificationContext& context,
   leaves->GiveBudgetShare(share);
   InterpretationTreeStats stats;
   SearchUnsearchedBranches(
-      *context.edges, *context.lines, *context.prior, WithBudgetShare(options.tree, share), caps,
+      {context.edges, context.lines, context.prior, &caps}, WithBudgetShare(options.tree, share),
       branches, [leaves](const Hypothesis& h) { return leaves->Visit(h); }, &stats,
       leaves->basins());
   result->tree_nodes += stats.nodes;
@@ -332,7 +332,7 @@ std::vector<VerifiedPose> SearchTree(const VerificationContext& context,
   LeafVerifier leaves(context, options.verification);
   InterpretationTreeStats stats;
   SearchInterpretationTree(
-      *context.edges, *context.lines, *context.prior, options.tree, caps,
+      {context.edges, context.lines, context.prior, &caps}, options.tree,
       [&leaves](const Hypothesis& h) { return leaves.Visit(h); }, &stats, leaves.basins());
   result->unary_candidates = stats.unary_candidates;
   result->tree_nodes = stats.nodes;

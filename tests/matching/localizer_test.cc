@@ -382,7 +382,7 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
     std::set<std::vector<std::pair<int, int>>> first;
     InterpretationTreeStats stats;
     SearchInterpretationTree(
-        edges, lines, prior, options, caps,
+        {&edges, &lines, &prior, &caps}, options,
         [&](const Hypothesis& h) {
           first.insert(key(h));
           return 0.0;
@@ -396,7 +396,7 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
     int visited = 0;
     InterpretationTreeStats resumed;
     SearchUnsearchedBranches(
-        edges, lines, prior, options, caps, branches,
+        {&edges, &lines, &prior, &caps}, options, branches,
         [&](const Hypothesis& h) {
           ++visited;
           EXPECT_EQ(first.count(key(h)), 0u);
