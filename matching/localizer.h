@@ -38,8 +38,8 @@ struct LocalizerOptions {
   double unexplained_search_share = 0.25;
   // Budgets of the search of the root branches an exhausted main search did not reach in the
   // pass it stopped in (after the searches over unexplained lines), as a share of the main
-  // search's: depth first, the first branch can take the whole budget (docs/matching-rounds.md,
-  // ninth round).
+  // search's: depth first, the root's first branch can take the whole budget while its siblings
+  // have the same bound.
   double unsearched_branches_share = 0.1;
 
   bool Check(std::string* why) const;
@@ -87,8 +87,8 @@ struct LocalizationResult {
   int hypotheses = 0;   // hypotheses verified (pose evaluations)
   int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
-  // The main tree search's InterpretationTreeStats::completed_bound (nats): leaves it did not
-  // visit have a bound below it when the budget ran out (docs/matching-rounds.md, eighth round).
+  // The main tree search's InterpretationTreeStats::completed_bound (nats): when the budget ran
+  // out, the leaves it did not visit have a bound below it.
   double tree_completed_bound = 0.0;
   // The largest completed_bound of the searches over unexplained lines (0 when none ran).
   double unexplained_completed_bound = 0.0;
@@ -101,7 +101,8 @@ struct LocalizationResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
-  // The doubted groups behind `covariance` (docs/matching-rounds.md, ninth round).
+  // The unreported pairs `covariance` averages over, grouped by edge, with their posterior
+  // (DoubtedCovariance, unreported_doubt.h).
   std::vector<DoubtedMatches> doubted;
 };
 

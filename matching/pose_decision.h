@@ -30,7 +30,7 @@ bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& o
 // W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
 // high-leverage unreported pairs left out at once); its own refinement when none is left out. An
 // unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
-// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107). `kept`,
+// not vouched for: the precision it gives is not the answer's. `kept`,
 // when given, receives the pairs of the refinement.
 PoseRefinementResult VouchedRefinement(const VerificationContext& context,
                                        const VerificationOptions& options,

@@ -24,8 +24,9 @@ struct LineMatch {
   Eigen::Matrix2d whitening = Eigen::Matrix2d::Identity();
 };
 
-// The region a refined pose may not leave (docs/matching-rounds.md, fifth round): the disk
-// of radius radius_m + sigmas * position sigma around centre, and headings within half_width_rad
+// The region a refined pose may not leave (the prior: a hypothesis' pairs alone may pull the pose
+// along a weakly observed direction far out of it): the disk of radius radius_m + sigmas *
+// position sigma around centre, and headings within half_width_rad
 // + sigmas * heading sigma of `heading`, the sigmas those of the image evidence at the pose
 // (PoseRefinementResult::position_sigma_m, heading_sigma_rad; RefinePose takes them at each step's
 // iterate and holds them during the step's trials). Outside it the cost gains the

@@ -1,5 +1,3 @@
-// The accepted pose's covariance averaged over its unreported pairs: law of total covariance over
-// "the group is true" / "the group is clutter" (docs/matching-rounds.md, ninth round).
 #include "matching/unreported_doubt.h"
 
 #include <algorithm>
@@ -142,8 +140,8 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
     // A rival line held by another edge of the interpretation is that pair undone, not free.
     from.held = &verified.pairs;
-    // Every pair of the group at the pose without all of it: twin false lines on one edge must
-    // not vouch for each other (the chain rule was measured: docs/matching-rounds.md, ninth round).
+    // Every pair of the group judged at the pose without all of it (not each at the pose of the
+    // group's other pairs): twin false lines on one edge must not vouch for each other.
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
       log_true += LogProbabilityTrue(

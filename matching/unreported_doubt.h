@@ -1,6 +1,6 @@
 // The accepted pose's covariance averaged over what its unreported pairs are (law of total
 // covariance): an unreported pair may be a clutter line that guided matching gave to an edge,
-// and the pose is then the pose of the other pairs (docs/matching-rounds.md, ninth round).
+// and the pose is then the pose of the other pairs (docs/matching.md, section 3).
 #pragma once
 
 #include <utility>

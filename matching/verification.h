@@ -25,7 +25,7 @@ struct VerificationOptions {
   double gate_chi2 = 13.8;
   double extent_sigmas = 3.0;
   int guided_rounds = 3;  // assignment + re-estimation rounds (fewer when it stops changing)
-  // A hypothesis whose own pairs have a chi-square beyond this quantile of chi2(2n - 4) at its
+  // A hypothesis whose own pairs have a chi-square beyond this quantile of chi2(2n - 3) at its
   // pose is inconsistent: rejected before guided matching (the early-out for hopeless ones).
   double hypothesis_quantile = 0.999;
   // An inconsistent hypothesis is restarted from the largest subset of its pairs that agrees
@@ -53,11 +53,10 @@ struct VerificationOptions {
   // verified plausible pose.
   double basin_sigmas = 3.0;
   // Bound of the tree search: a line is counted for this share of its cap
-  // (MaxLogLikelihoodRatio). Not a strict bound: on 300 synthetic scenes of seed 7 (not a
-  // benchmark seed) the accepted true poses reached 0.655 of their lines' caps in the median,
-  // 0.847 at the 99th percentile, 0.891 at most; 0.7 cuts the subtrees that could only win with
-  // better-than-typical lines, and the truth, searched first by iterative deepening, is rarely
-  // one of them (docs/matching-rounds.md, third round).
+  // (MaxLogLikelihoodRatio). Not a strict bound but a typical share: true poses reach about two
+  // thirds of their lines' caps (docs/matching.md, section 2), so 0.7 cuts the subtrees that
+  // could only win with better-than-typical lines, and the truth, searched first by iterative
+  // deepening, is rarely one of them.
   double cap_efficiency = 0.7;
   // Work budget of the verification (deterministic): (line, visible edge) pairs guided matching
   // may test over all hypotheses of one localisation; then no more hypotheses are verified.
@@ -67,8 +66,7 @@ struct VerificationOptions {
   double max_heading_sigma_deg = 5.0;
   // The accepted pose's covariance does not lean on an unreported pair whose leverage (largest
   // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
-  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching-rounds.md, seventh
-  // round).
+  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, pose_decision.h).
   double max_unreported_leverage = 0.75;
   // The accepted pose's covariance then also averages over what its unreported pairs are: each
   // edge's unreported pairs are false with their posterior probability, and the pose is then
@@ -198,8 +196,9 @@ void CompleteEvidence(const VerificationContext& context, const VerificationOpti
 
 // True when two refined hypotheses of the same pairs are one pose: positions within 1 cm,
 // headings within 0.1 degree and focal scales within 0.1 % (a hundred times the verification's
-// Levenberg-Marquardt step tolerance, far below the poses' noise of about 7 cm and 0.3 degree).
-// Guided matching from either gives the same verified pose (the localizer verifies it once).
+// Levenberg-Marquardt step tolerance, far below the poses' noise of centimetres and tenths of a
+// degree). Guided matching from either gives the same verified pose (the localizer verifies it
+// once).
 bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b);
 
 }  // namespace linetrack

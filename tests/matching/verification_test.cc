@@ -316,8 +316,8 @@ TEST_F(VerificationTest, DoubtedCovarianceWidensOnlyOverUnreportedPairs) {
 
 // The posterior of a true group is judged by the others' pose, but which edges are in view, over
 // which stretch, from the pose where the pairs were found: a small shift must not push a true
-// edge out of the frame or leave its line overhanging a projection clipped at the border (ninth
-// round: such pairs got p = 0 although true); and a rival line that another true pair holds is
+// edge out of the frame or leave its line overhanging a projection clipped at the border (which
+// would give a true pair p = 0); and a rival line that another true pair holds is
 // not a free explanation (the summed doubt of true groups stays below kMaxTrueGroupsDoubt).
 TEST_F(VerificationTest, TrueGroupsKeepAPosteriorAtTheImageBorder) {
   int groups = 0, lost = 0;
