@@ -55,27 +55,27 @@ struct Hypothesis {
   double bound = 0.0;
 };
 
-// A pose already verified and what would be verified into it again: subtrees whose region lies
+// A plausible verified pose and what would be verified into it again: subtrees whose region lies
 // in its neighbourhood (radius_m, heading_rad) unless their bound exceeds its evidence (the
 // verified pose may hold a wrong pair; a better leaf there is a better version of the same
-// answer), leaves whose region holds the pose, and subtrees
-// all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
-// pose) and fewer lines than it explains.
-struct VerifiedBasin {
+// answer), leaves whose region holds the pose, and subtrees all of whose leaves would have most
+// of their pairs in its consensus set and fewer lines than it explains.
+struct VerifiedNeighbourhood {
   Pose3Dof pose;
-  // Its neighbourhood (basin_sigmas standard deviations).
+  // Its neighbourhood: neighbourhood_sigmas standard deviations of position and heading.
   double radius_m = 0.0;
   double heading_rad = 0.0;
   int lines = 0;          // lines the verified pose explains
-  double evidence = 0.0;  // its evidence (nats): a subtree in its basin must be able to beat it
-  std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
+  double evidence = 0.0;  // its evidence (nats): a subtree in its neighbourhood must beat it
+  // Its consensus set (ConsensusSet): (edge index, line index) pairs within the gate, sorted.
+  std::vector<std::pair<int, int>> consensus;
 };
 
 // True when `pairs` (edge index, line index) give a line to another edge than a verified pose
-// does: a pair not in the pose's `fitting` pairs (sorted) whose line is in one of them. Such a
-// leaf is another interpretation, not the verified pose again, even when its region holds it.
+// does: a pair not in the pose's consensus set (sorted) whose line is in one of its pairs. Such
+// a leaf is another interpretation, not the verified pose again, even when its region holds it.
 bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
-                          const std::vector<std::pair<int, int>>& fitting);
+                          const std::vector<std::pair<int, int>>& consensus);
 
 // The root's branches an exhausted search did not reach in the pass the budget stopped: the
 // root's line (index into the lines), the edges it was still to take (indices into the edges; -1:
@@ -116,12 +116,12 @@ struct TreeProblem {
 // ambiguity margin); return 0 to keep the current one.
 using LeafVisitor = std::function<double(const Hypothesis&)>;
 
-// Searches the tree depth first, assignments (lines by decreasing cap) before skips. `basins`
-// (may be null; the visitor may add to it) are read at every node. Deterministic: the same input
-// gives the same leaves in the same order.
+// Searches the tree depth first, assignments (lines by decreasing cap) before skips.
+// `neighbourhoods` (may be null; the visitor may add to it) are read at every node. Deterministic:
+// the same input gives the same leaves in the same order.
 void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const LeafVisitor& visit, InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins = nullptr);
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods = nullptr);
 
 // Searches the root branches an exhausted search of the same problem did not reach, at the
 // bound of the pass it stopped in, each with an equal share of the options' budgets; leaves as
@@ -130,7 +130,7 @@ void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTr
 void SearchUnsearchedBranches(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins = nullptr);
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods = nullptr);
 
 // All leaves with at least options.min_matches correspondences (no bound).
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,

@@ -142,8 +142,8 @@ class LeafVerifier {
     }
     // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
     // agreeing pairs): guided matching from it would give the same pose again, which the
-    // verified poses, basins and best evidence already hold. Its share of the work budget still
-    // counts.
+    // verified poses, neighbourhoods and best evidence already hold. Its share of the work budget
+    // still counts.
     std::vector<RematchedHypothesis>& known = rematched_[Sorted(leaf.pairs)];
     if (AlreadyVerified(leaf, known, &stats_.pair_tests)) return Bound();
     const long tests_before = stats_.pair_tests;
@@ -162,7 +162,7 @@ class LeafVerifier {
 
   const std::vector<VerifiedPose>& verified() const { return verified_; }
   std::vector<VerifiedPose> TakeVerified() { return std::move(verified_); }
-  const std::vector<VerifiedBasin>* basins() const { return &basins_; }
+  const std::vector<VerifiedNeighbourhood>* neighbourhoods() const { return &neighbourhoods_; }
   int hypotheses() const { return hypotheses_; }
   bool budget_exhausted() const { return budget_exhausted_; }
 
@@ -181,11 +181,11 @@ class LeafVerifier {
       }
     }
     const int size = static_cast<int>(h.pairs.size());
-    for (const VerifiedBasin& b : basins_) {
+    for (const VerifiedNeighbourhood& b : neighbourhoods_) {
       if (size > b.lines) continue;  // neither test below can hold: no pair counted
       const int fit =
           static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
-            return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
+            return std::binary_search(b.consensus.begin(), b.consensus.end(), p);
           }));
       if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) return true;
     }
@@ -193,16 +193,17 @@ class LeafVerifier {
   }
 
   // Keeps a verified leaf. Leaves that would be verified into a plausible pose again are not
-  // verified: those whose region holds it or lies within basin_sigmas of its standard
+  // verified: those whose region holds it or lies within neighbourhood_sigmas of its standard
   // deviations, and those most of whose pairs fit it.
   void Record(VerifiedPose v) {
     if (v.plausible) {
       CompleteEvidence(context_, options_, &v);
       best_ = std::max(best_, v.evidence.Score());
-      basins_.push_back({v.pose, options_.basin_sigmas * v.refinement.position_sigma_m,
-                         options_.basin_sigmas * v.refinement.heading_sigma_rad,
-                         static_cast<int>(v.pairs.size()), v.evidence.Score(),
-                         FittingPairs(context_, options_, v)});
+      neighbourhoods_.push_back({v.pose,
+                                 options_.neighbourhood_sigmas * v.refinement.position_sigma_m,
+                                 options_.neighbourhood_sigmas * v.refinement.heading_sigma_rad,
+                                 static_cast<int>(v.pairs.size()), v.evidence.Score(),
+                                 ConsensusSet(context_, options_, v)});
     }
     verified_pairs_.push_back(Sorted(v.pairs));
     verified_.push_back(std::move(v));
@@ -212,7 +213,7 @@ class LeafVerifier {
   const VerificationOptions& options_;
   std::vector<VerifiedPose> verified_;
   std::vector<std::vector<std::pair<int, int>>> verified_pairs_;  // each sorted
-  std::vector<VerifiedBasin> basins_;
+  std::vector<VerifiedNeighbourhood> neighbourhoods_;
   double best_ = -std::numeric_limits<double>::infinity();
   VerificationStats stats_;
   ConsensusMemo memo_;
@@ -317,7 +318,7 @@ void SearchUnsearchedRootBranches(const VerificationContext& context,
   SearchUnsearchedBranches(
       {context.edges, context.lines, context.prior, &caps}, WithBudgetShare(options.tree, share),
       branches, [leaves](const Hypothesis& h) { return leaves->Visit(h); }, &stats,
-      leaves->basins());
+      leaves->neighbourhoods());
   result->tree_nodes += stats.nodes;
   result->tree_checks += stats.checks;
 }
@@ -333,7 +334,7 @@ std::vector<VerifiedPose> SearchTree(const VerificationContext& context,
   InterpretationTreeStats stats;
   SearchInterpretationTree(
       {context.edges, context.lines, context.prior, &caps}, options.tree,
-      [&leaves](const Hypothesis& h) { return leaves.Visit(h); }, &stats, leaves.basins());
+      [&leaves](const Hypothesis& h) { return leaves.Visit(h); }, &stats, leaves.neighbourhoods());
   result->unary_candidates = stats.unary_candidates;
   result->tree_nodes = stats.nodes;
   result->tree_checks = stats.checks;

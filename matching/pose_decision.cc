@@ -33,11 +33,11 @@ bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& o
          std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(options.same_pose_deg);
 }
 
-PoseRefinementResult VouchedRefinement(const VerificationContext& context,
-                                       const VerificationOptions& options,
-                                       const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported,
-                                       std::vector<std::pair<int, int>>* kept_pairs) {
+PoseRefinementResult LowLeverageRefinement(const VerificationContext& context,
+                                           const VerificationOptions& options,
+                                           const VerifiedPose& verified,
+                                           const std::vector<std::pair<int, int>>& reported,
+                                           std::vector<std::pair<int, int>>* kept_pairs) {
   const std::vector<LineMatch> matches = ToLineMatches(context, verified.pairs);
   const Eigen::Matrix4d& c = verified.refinement.covariance;
   std::vector<LineMatch> kept;
@@ -173,15 +173,16 @@ Eigen::Matrix4d AnswerCovariance(const VerificationContext& context,
                                  const VerificationOptions& options, const VerifiedPose& best,
                                  const std::vector<std::pair<int, int>>& reported,
                                  std::vector<DoubtedGroup>* groups) {
-  // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
+  // The answer's precision comes from the pairs it can lean on: not from an unreported pair that
   // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
-  VerifiedPose vouched = best;
-  vouched.refinement = VouchedRefinement(context, options, best, reported, &vouched.pairs);
-  vouched.pose = vouched.refinement.pose;
+  VerifiedPose low_leverage = best;
+  low_leverage.refinement =
+      LowLeverageRefinement(context, options, best, reported, &low_leverage.pairs);
+  low_leverage.pose = low_leverage.refinement.pose;
   const bool observable =
-      vouched.refinement.position_sigma_m <= options.max_position_sigma_m &&
-      vouched.refinement.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
-  const VerifiedPose& base = observable ? vouched : best;
+      low_leverage.refinement.position_sigma_m <= options.max_position_sigma_m &&
+      low_leverage.refinement.heading_sigma_rad <= DegToRad(options.max_heading_sigma_deg);
+  const VerifiedPose& base = observable ? low_leverage : best;
   // And it averages over what the unreported pairs it keeps are (true or clutter).
   return options.doubt_unreported_pairs
              ? DoubtedCovariance(context, options, base, reported, groups)

@@ -29,14 +29,14 @@ bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& o
 // correspondences) and those of its other pairs whose leverage at its pose (largest eigenvalue of
 // W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
 // high-leverage unreported pairs left out at once); its own refinement when none is left out. An
-// unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
-// not vouched for: the precision it gives is not the answer's. `kept`,
-// when given, receives the pairs of the refinement.
-PoseRefinementResult VouchedRefinement(const VerificationContext& context,
-                                       const VerificationOptions& options,
-                                       const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported,
-                                       std::vector<std::pair<int, int>>* kept = nullptr);
+// unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair): the
+// precision it gives is not the answer's. `kept`, when given, receives the pairs of the
+// refinement.
+PoseRefinementResult LowLeverageRefinement(const VerificationContext& context,
+                                           const VerificationOptions& options,
+                                           const VerifiedPose& verified,
+                                           const std::vector<std::pair<int, int>>& reported,
+                                           std::vector<std::pair<int, int>>* kept = nullptr);
 
 // The poses a verified pose's pairs give without one of its influential pairs (the first-order
 // deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
@@ -69,7 +69,7 @@ bool ClearlyBest(const VerificationContext& context, const VerificationOptions& 
                  std::string* why);
 
 // The accepted pose's covariance (heading, x, y, scale): that of the pairs it can lean on
-// (VouchedRefinement; its own when they leave the pose unobservable), averaged over what its
+// (LowLeverageRefinement; its own when they leave the pose unobservable), averaged over what its
 // unreported pairs are when options.doubt_unreported_pairs (DoubtedCovariance, whose groups
 // `groups` receives).
 Eigen::Matrix4d AnswerCovariance(const VerificationContext& context,

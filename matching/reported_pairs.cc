@@ -83,12 +83,12 @@ PairExplanations ExplainPair(const VerificationContext& context, const Verificat
     if (fragments_of_one(*own, c)) {
       out.fragments = out.fragments || c.fit.log_likelihood_ratio > 0.0;
     } else {
-      double displaced = 0.0;  // the ratio of the pair that holds the rival line, if any
-      if (from.held != nullptr) {
-        for (const auto& [e, l] : *from.held) {
+      double displaced = 0.0;  // the ratio of the pair that explains the rival line, if any
+      if (from.interpretation != nullptr) {
+        for (const auto& [e, l] : *from.interpretation) {
           if (l != c.line || e == edge) continue;
-          const auto holder = fit_of(e, l);
-          if (holder != fits.end()) displaced += holder->fit.log_likelihood_ratio;
+          const auto other = fit_of(e, l);
+          if (other != fits.end()) displaced += other->fit.log_likelihood_ratio;
         }
       }
       out.rivals.push_back(c.fit.log_likelihood_ratio - displaced);
@@ -106,7 +106,7 @@ std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContex
                             verified.pairs[i])) {
       continue;
     }
-    // The pose of the other pairs: the pair's line must not vouch for itself. When the pair
+    // The pose of the other pairs: the pair's line must not confirm itself. When the pair
     // alone fixes a direction of the pose, its own pose is all there is.
     Pose3Dof pose;
     Eigen::Matrix4d covariance;

@@ -18,7 +18,7 @@ namespace linetrack {
 // line; another line for the edge that cannot be a fragment of the same image), and whether the
 // edge has such fragments there likelier than clutter. `from` may move visibility, extent and
 // occlusion to another pose, give the pair's ratio beyond the gates, and price rival lines that
-// other pairs hold.
+// other pairs of the interpretation explain.
 struct PairExplanations {
   double own = -std::numeric_limits<double>::infinity();
   std::vector<double> rivals;
@@ -30,9 +30,10 @@ struct ExplainFrom {
   std::optional<PoseAndScale> seen;
   // The pair's own ratio also beyond the gates (across the line and on its extent).
   bool beyond_gates = false;
-  // When given: the interpretation's pairs (edge, line). A rival line that another edge holds
-  // there would undo that pair (a line is one edge's image at most): its ratio minus the holder's.
-  const std::vector<std::pair<int, int>>* held = nullptr;
+  // When given: the interpretation's pairs (edge, line). A rival line that another edge of it
+  // explains would undo that pair (a line is one edge's image at most): its ratio minus that
+  // pair's.
+  const std::vector<std::pair<int, int>>* interpretation = nullptr;
 };
 PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
                              const PoseAndScale& at, const Eigen::Matrix4d& covariance,

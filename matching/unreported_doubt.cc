@@ -132,16 +132,16 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     pose.x += group.shift(1);
     pose.y += group.shift(2);
     const double scale = verified.refinement.focal_scale + group.shift(3);
-    // The lines and their uncertainty from the pose without the group (a line must not vouch
+    // The lines and their uncertainty from the pose without the group (a line must not confirm
     // for itself); which edges are in view, over which stretch and unhidden, from the pose where
     // the pairs were found (a small shift must not push a seen edge out of the frame).
     ExplainFrom from;
     from.seen = PoseAndScale{verified.pose, verified.refinement.focal_scale};
     from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
-    // A rival line held by another edge of the interpretation is that pair undone, not free.
-    from.held = &verified.pairs;
+    // A rival line another edge of the interpretation explains is that pair undone, not free.
+    from.interpretation = &verified.pairs;
     // Every pair of the group judged at the pose without all of it (not each at the pose of the
-    // group's other pairs): twin false lines on one edge must not vouch for each other.
+    // group's other pairs): two false lines on one edge must not confirm each other.
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
       log_true += LogProbabilityTrue(

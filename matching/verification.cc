@@ -234,7 +234,7 @@ double HypothesisEvidence(const VerificationContext& context, const Verification
   return total;
 }
 
-std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+std::vector<std::pair<int, int>> ConsensusSet(const VerificationContext& context,
                                               const VerificationOptions& options,
                                               const VerifiedPose& verified) {
   const double sigma_theta = DegToRad(context.noise.angle_deg);
@@ -244,7 +244,7 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
     whitening.push_back(
         Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta)));
   }
-  std::vector<std::pair<int, int>> fitting;
+  std::vector<std::pair<int, int>> consensus;
   const PoseView view = ViewOf(verified.pose, context.height, context.tilt);
   for (size_t e = 0; e < context.edges->size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
@@ -255,11 +255,11 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
       const Eigen::Vector2d r(image_line.dot(Eigen::Vector3d(s.a.x(), s.a.y(), 1.0)),
                               image_line.dot(Eigen::Vector3d(s.b.x(), s.b.y(), 1.0)));
       if ((whitening[l] * r).squaredNorm() <= options.gate_chi2) {
-        fitting.emplace_back(static_cast<int>(e), static_cast<int>(l));
+        consensus.emplace_back(static_cast<int>(e), static_cast<int>(l));
       }
     }
   }
-  return fitting;
+  return consensus;
 }
 
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,

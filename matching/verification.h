@@ -51,7 +51,7 @@ struct VerificationOptions {
   double same_pose_deg = 5.0;
   // The tree does not explore again regions within this many standard deviations of a
   // verified plausible pose.
-  double basin_sigmas = 3.0;
+  double neighbourhood_sigmas = 3.0;
   // Bound of the tree search: a line is counted for this share of its cap
   // (MaxLogLikelihoodRatio). Not a strict bound but a typical share: true poses reach about two
   // thirds of their lines' caps (docs/matching.md, section 2), so 0.7 cuts the subtrees that
@@ -66,7 +66,7 @@ struct VerificationOptions {
   double max_heading_sigma_deg = 5.0;
   // The accepted pose's covariance does not lean on an unreported pair whose leverage (largest
   // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
-  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, pose_decision.h).
+  // 1 / (1 - leverage), 4 times at 0.75 (LowLeverageRefinement, pose_decision.h).
   double max_unreported_leverage = 0.75;
   // The accepted pose's covariance then also averages over what its unreported pairs are: each
   // edge's unreported pairs are false with their posterior probability, and the pose is then
@@ -170,10 +170,10 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
 double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
                           const VerifiedPose& hypothesis);
 
-// Every (edge index, line index) pair that fits the verified pose: whitened endpoint residuals
-// at its pose and focal scale within gate_chi2 (sorted). A hypothesis most of whose pairs fit a
-// verified pose would be verified into it again.
-std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+// The consensus set of a verified pose: every (edge index, line index) pair whose whitened
+// endpoint residuals at its pose and focal scale are within gate_chi2 (sorted). A hypothesis most
+// of whose pairs are in it would be verified into that pose again.
+std::vector<std::pair<int, int>> ConsensusSet(const VerificationContext& context,
                                               const VerificationOptions& options,
                                               const VerifiedPose& verified);
 

@@ -255,7 +255,7 @@ TEST_F(LocalizerTest, PoseHeldInsideThePriorRivalsAsUnobservable) {
 // Seed 2 QI1 scene 107: 7 true pairs leave the pose loose along a valley; guided matching adds a
 // clutter line (line 9) to edge 57 with leverage near 1, unreported, which alone would fix the
 // heading far more precisely than the true pairs do. The answer's covariance leans only on the
-// pairs it vouches for, so it holds the truth.
+// reported pairs and the unreported ones of low leverage, so it holds the truth.
 TEST_F(LocalizerTest, CovarianceDoesNotLeanOnAnUnreportedHighLeveragePair) {
   SyntheticScene scene;
   const LocalizationResult r = LocalizeBenchmarkScene(2, 0.30, 10.0, 107, &scene);
@@ -274,7 +274,7 @@ TEST_F(LocalizerTest, CovarianceDoesNotLeanOnAnUnreportedHighLeveragePair) {
 }
 
 // Seed 1 QI1 scene 77: guided matching gives a clutter line to vertical edge 50, unreported, with
-// leverage below max_unreported_leverage (so the vouched covariance keeps it); the answer is about
+// leverage below max_unreported_leverage (so LowLeverageRefinement keeps it); the answer is about
 // half a metre from the truth. Leaning on that pair the covariance excludes the truth; averaged
 // over "the pair is clutter" (its posterior at the pose of the others) it holds the truth. The
 // pose and the reported pairs are the same either way.
@@ -307,11 +307,11 @@ TEST_F(LocalizerTest, CovarianceAveragesOverWhatTheUnreportedPairsAre) {
 // gives line 4 to edge 38. Pairs that fit the pose, or lines the pose does not explain, are no
 // contradiction.
 TEST(AssignsLineOtherwiseTest, OnlyALineOnAnotherEdgeContradicts) {
-  const std::vector<std::pair<int, int>> fitting = {{16, 9}, {18, 6}, {19, 4}, {38, 5}};
-  EXPECT_TRUE(AssignsLineOtherwise({{16, 9}, {38, 4}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {19, 4}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {35, 7}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({}, fitting));
+  const std::vector<std::pair<int, int>> consensus = {{16, 9}, {18, 6}, {19, 4}, {38, 5}};
+  EXPECT_TRUE(AssignsLineOtherwise({{16, 9}, {38, 4}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {19, 4}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {35, 7}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({}, consensus));
 }
 
 // The tree's completed_bound: when the budget stops the search, every leaf whose bound reaches
