@@ -24,7 +24,11 @@ bool LocalizerOptions::Check(std::string* why) const {
     *why = "unsearched_branches_share: must be in [0, 1]";
     return false;
   }
-  return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
+  if (method == MatchMethod::kHypothesizeAndTest && !sampler) {
+    *why = "method: hypothesise-and-test needs a sampler";
+    return false;
+  }
+  return noise.Check(why) && tree.Check(why) && verification.Check(why);
 }
 
 void CheckProblem(const LocalizationProblem& p) {
@@ -434,9 +438,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   if (options_.method == MatchMethod::kInterpretationTree) {
     verified = SearchTree(context, options_, &result);
   } else {
-    BaselineStats stats;
-    verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);
-    result.samples = stats.samples;
+    verified = options_.sampler(context, prior, options_.verification, &result.samples);
     result.hypotheses = static_cast<int>(verified.size());
   }
   Decide(std::move(verified), context, options_.verification, &result);

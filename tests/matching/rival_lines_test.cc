@@ -13,7 +13,7 @@
 #include "matching/pose_refinement.h"
 #include "matching/reported_pairs.h"
 #include "matching/verification.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {

@@ -15,7 +15,7 @@
 #include "matching/hypothesis_trimming.h"
 #include "matching/pose_decision.h"
 #include "matching/unreported_doubt.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {
