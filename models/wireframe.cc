@@ -121,11 +121,11 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
   };
 
   for (const auto& line : cao.lines)
-    add_edge(line[0], line[1], /*from_line=*/true, /*face=*/-1);
+    add_edge(line[0], line[1], true, -1);
   for (size_t f = 0; f < cao.faces.size(); ++f) {
     const std::vector<int>& face = cao.faces[f];
     for (size_t i = 0; i < face.size(); ++i) {
-      add_edge(face[i], face[(i + 1) % face.size()], /*from_line=*/false, static_cast<int>(f));
+      add_edge(face[i], face[(i + 1) % face.size()], false, static_cast<int>(f));
     }
   }
   if (degenerate > 0) {

@@ -162,6 +162,8 @@ void HoughLineDetector::ExtractChains(double theta_deg, double rho,
   std::vector<int> hits;
   std::vector<double> positions;
   Walk(theta_deg, rho, options_.max_distance_px, &hits, &positions);
+  const int half_window =
+      static_cast<int>(std::floor(options_.orientation_window_deg / options_.theta_step_deg));
   for (const auto& [first, last] :
        SplitRuns(positions, options_.max_gap_px, options_.min_length_px)) {
     std::vector<Eigen::Vector2d> points;
@@ -194,28 +196,36 @@ void HoughLineDetector::ExtractChains(double theta_deg, double rho,
     for (int index : kept_indices) {
       if (used_[index]) continue;
       used_[index] = 1;
-      Vote(pixels_[index], -1);
+      const EdgePixel& px = pixels_[index];
+      const int centre_bin = static_cast<int>(std::lround(px.theta_deg / options_.theta_step_deg));
+      for (int k = centre_bin - half_window; k <= centre_bin + half_window; ++k) {
+        const int kk = (k % n_theta_ + n_theta_) % n_theta_;
+        const double r =
+            (px.x - 0.5 * (width_ - 1)) * cos_[kk] + (px.y - 0.5 * (height_ - 1)) * sin_[kk];
+        const int rb = static_cast<int>(std::lround(r + rho_max_));
+        --accumulator_[static_cast<size_t>(kk) * n_rho_ + rb];
+      }
     }
   }
 }
 
-void HoughLineDetector::Resize(int width, int height) {
-  width_ = width;
-  height_ = height;
-  n_theta_ = static_cast<int>(std::lround(180.0 / options_.theta_step_deg));
-  rho_max_ = std::ceil(0.5 * std::hypot(width_, height_)) + 1.0;
-  n_rho_ = 2 * static_cast<int>(rho_max_) + 1;
-  cos_.resize(n_theta_);
-  sin_.resize(n_theta_);
-  for (int k = 0; k < n_theta_; ++k) {
-    cos_[k] = std::cos(DegToRad(k * options_.theta_step_deg));
-    sin_[k] = std::sin(DegToRad(k * options_.theta_step_deg));
+std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
+  CV_Assert(grey.type() == CV_8UC1 && !grey.empty());
+  if (grey.cols != width_ || grey.rows != height_ || n_theta_ == 0) {
+    width_ = grey.cols;
+    height_ = grey.rows;
+    n_theta_ = static_cast<int>(std::lround(180.0 / options_.theta_step_deg));
+    rho_max_ = std::ceil(0.5 * std::hypot(width_, height_)) + 1.0;
+    n_rho_ = 2 * static_cast<int>(rho_max_) + 1;
+    cos_.resize(n_theta_);
+    sin_.resize(n_theta_);
+    for (int k = 0; k < n_theta_; ++k) {
+      cos_[k] = std::cos(DegToRad(k * options_.theta_step_deg));
+      sin_[k] = std::sin(DegToRad(k * options_.theta_step_deg));
+    }
+    accumulator_.assign(static_cast<size_t>(n_theta_) * n_rho_, 0);
+    pixel_at_.assign(static_cast<size_t>(width_) * height_, -1);
   }
-  accumulator_.assign(static_cast<size_t>(n_theta_) * n_rho_, 0);
-  pixel_at_.assign(static_cast<size_t>(width_) * height_, -1);
-}
-
-void HoughLineDetector::FindEdgePixels(const cv::Mat& grey) {
   if (options_.blur_sigma > 0.0) {
     cv::GaussianBlur(grey, smoothed_, cv::Size(0, 0), options_.blur_sigma);
   } else {
@@ -223,7 +233,9 @@ void HoughLineDetector::FindEdgePixels(const cv::Mat& grey) {
   }
   cv::Sobel(smoothed_, dx_, CV_16S, 1, 0, 3);
   cv::Sobel(smoothed_, dy_, CV_16S, 0, 1, 3);
-  cv::Canny(dx_, dy_, edges_, options_.canny_low, options_.canny_high, /*L2gradient=*/true);
+  cv::Canny(dx_, dy_, edges_, options_.canny_low, options_.canny_high, true);
+
+  // Edge pixels and their gradient orientation (modulo 180 degrees: the line's normal angle).
   pixels_.clear();
   std::fill(pixel_at_.begin(), pixel_at_.end(), -1);
   for (int y = 0; y < height_; ++y) {
@@ -241,21 +253,25 @@ void HoughLineDetector::FindEdgePixels(const cv::Mat& grey) {
   used_.assign(pixels_.size(), 0);
   seen_stamp_.assign(pixels_.size(), 0);
   stamp_ = 0;
-}
 
-void HoughLineDetector::Vote(const EdgePixel& pixel, int delta) {
+  // Votes, limited to the normals within the orientation window of each pixel's gradient.
+  std::fill(accumulator_.begin(), accumulator_.end(), 0);
   const int half_window =
       static_cast<int>(std::floor(options_.orientation_window_deg / options_.theta_step_deg));
   const double cx = 0.5 * (width_ - 1), cy = 0.5 * (height_ - 1);
-  const int centre_bin = static_cast<int>(std::lround(pixel.theta_deg / options_.theta_step_deg));
-  for (int k = centre_bin - half_window; k <= centre_bin + half_window; ++k) {
-    const int kk = (k % n_theta_ + n_theta_) % n_theta_;
-    const double r = (pixel.x - cx) * cos_[kk] + (pixel.y - cy) * sin_[kk];
-    accumulator_[static_cast<size_t>(kk) * n_rho_ + std::lround(r + rho_max_)] += delta;
+  for (const EdgePixel& px : pixels_) {
+    const int centre_bin = static_cast<int>(std::lround(px.theta_deg / options_.theta_step_deg));
+    for (int k = centre_bin - half_window; k <= centre_bin + half_window; ++k) {
+      const int kk = (k % n_theta_ + n_theta_) % n_theta_;
+      const double r = (px.x - cx) * cos_[kk] + (px.y - cy) * sin_[kk];
+      ++accumulator_[static_cast<size_t>(kk) * n_rho_ + std::lround(r + rho_max_)];
+    }
   }
-}
 
-std::vector<HoughLineDetector::Peak> HoughLineDetector::Peaks() const {
+  // Local maxima of the accumulator (theta wraps with rho mirrored), strongest first.
+  struct Peak {
+    int votes, k, r;
+  };
   std::vector<Peak> peaks;
   auto at = [&](int k, int r) {
     if (k < 0 || k >= n_theta_) {
@@ -286,18 +302,9 @@ std::vector<HoughLineDetector::Peak> HoughLineDetector::Peaks() const {
     return a.votes != b.votes ? a.votes > b.votes : (a.k != b.k ? a.k < b.k : a.r < b.r);
   });
   if (static_cast<int>(peaks.size()) > options_.max_peaks) peaks.resize(options_.max_peaks);
-  return peaks;
-}
 
-std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
-  CV_Assert(grey.type() == CV_8UC1 && !grey.empty());
-  if (grey.cols != width_ || grey.rows != height_ || n_theta_ == 0) Resize(grey.cols, grey.rows);
-  FindEdgePixels(grey);
-  std::fill(accumulator_.begin(), accumulator_.end(), 0);
-  for (const EdgePixel& pixel : pixels_)
-    Vote(pixel, 1);
   std::vector<Segment2> segments;
-  for (const Peak& peak : Peaks()) {
+  for (const Peak& peak : peaks) {
     // Votes of pixels already explained by stronger lines have been withdrawn.
     if (accumulator_[static_cast<size_t>(peak.k) * n_rho_ + peak.r] < options_.min_votes) continue;
     ExtractChains(peak.k * options_.theta_step_deg, peak.r - rho_max_, &segments);

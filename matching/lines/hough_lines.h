@@ -49,20 +49,6 @@ class HoughLineDetector {
     int x = 0, y = 0;
     float theta_deg = 0.0f;  // gradient direction modulo 180 degrees (the line's normal angle)
   };
-  // An accumulator cell: its votes, normal-angle bin and offset bin.
-  struct Peak {
-    int votes, k, r;
-  };
-  // Accumulator and trigonometry tables for images of `width` x `height` pixels.
-  void Resize(int width, int height);
-  // The Canny edge pixels of `grey` and their gradient orientation; clears the per-pixel marks.
-  void FindEdgePixels(const cv::Mat& grey);
-  // Adds `delta` votes of `pixel` to the normals within the orientation window of its gradient
-  // (-1 withdraws them), each at the offset rho = (x - cx) cos(theta) + (y - cy) sin(theta).
-  void Vote(const EdgePixel& pixel, int delta);
-  // Local maxima of the accumulator of at least min_votes (theta wraps with rho mirrored),
-  // strongest first, at most max_peaks.
-  std::vector<Peak> Peaks() const;
   // Edge pixels within `tolerance` of the line (normal angle theta, offset rho from the image
   // centre) and orientation-compatible, ordered along the line.
   void Walk(double theta_deg, double rho, double tolerance, std::vector<int>* hits,

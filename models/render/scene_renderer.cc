@@ -23,6 +23,12 @@ constexpr double kMaxCanvasGrowth = 4.0;    // largest undistorted canvas / imag
 constexpr float kBackground = 60.0f;        // grey level where no surface is seen
 constexpr int kShadeStep = 4;               // pixels between exact shading evaluations
 
+// Pinhole of a grid of samples: sample (i, j) centred at integer coordinates.
+struct SampleCamera {
+  double px = 1.0, py = 1.0, u0 = 0.0, v0 = 0.0;
+  int width = 0, height = 0;
+};
+
 // Shading constants of one surface (independent of the view).
 struct SurfaceShading {
   Eigen::Vector3d normal, e1, e2;
@@ -87,7 +93,7 @@ void SceneRenderer::Impl::Rasterize(const Eigen::Isometry3d& cam_from_world,
     const RenderSurface& surface = scene.surfaces[s];
     // Plane n . X = d in the world: (R n) . X_cam = d - n . C in the camera.
     facing[s] = PlaneInverseDepth(r * surface.normal, surface.offset - surface.normal.dot(centre),
-                                  cam, &coeffs[s]);
+                                  cam.px, cam.py, cam.u0, cam.v0, &coeffs[s]);
   }
   zbuffer.Resize(cam.width, cam.height);
   zbuffer.ClearToPlanes(

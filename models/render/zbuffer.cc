@@ -5,12 +5,11 @@
 
 namespace linetrack {
 
-bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam,
-                       const SampleCamera& camera, Eigen::Vector3d* coeffs) {
+bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam, double px, double py,
+                       double u0, double v0, Eigen::Vector3d* coeffs) {
   // X = z (x, y, 1) with x = (i - u0) / px: n . X = d gives 1/z = n . (x, y, 1) / d.
   if (std::abs(offset_cam) < 1e-12) return false;
   const Eigen::Vector3d& n = normal_cam;
-  const double px = camera.px, py = camera.py, u0 = camera.u0, v0 = camera.v0;
   *coeffs = Eigen::Vector3d(n.x() / px, n.y() / py, n.z() - n.x() * u0 / px - n.y() * v0 / py) /
             offset_cam;
   return true;

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 #include "models/errors.h"
 
@@ -66,11 +65,10 @@ std::vector<Segment2> MeasuredPieces(const Segment2& image, bool fragment,
 }
 
 // The image of a random unmodelled vertical segment standing on the floor in front of the
-// camera, visible (not behind a wall) and long enough; nullopt when none was found.
-std::optional<Segment2> VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
-                                            const OcclusionTester& occlusion,
-                                            const NavigableArea& area,
-                                            const SyntheticSceneOptions& o, SceneRandom* rng) {
+// camera, visible (not behind a wall) and long enough; false when none was found.
+bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
+                         const OcclusionTester& occlusion, const NavigableArea& area,
+                         const SyntheticSceneOptions& o, SceneRandom* rng, Segment2* line) {
   const Eigen::Isometry3d cam_from_world = CamFromWorld(truth);
   const double half_fov = std::atan2(0.5 * camera.width, camera.px);
   for (int i = 0; i < kMaxClutterDraws; ++i) {
@@ -89,11 +87,12 @@ std::optional<Segment2> VerticalClutterLine(const RobotPose& truth, const Camera
     }
     const Segment2 image{camera.Project(cam_from_world * segment.a),
                          camera.Project(cam_from_world * segment.b)};
-    const std::vector<Segment2> pieces = MeasuredPieces(image, /*fragment=*/false, o, rng);
+    const std::vector<Segment2> pieces = MeasuredPieces(image, false, o, rng);
     if (pieces.empty()) continue;
-    return pieces.front();
+    *line = pieces.front();
+    return true;
   }
-  return std::nullopt;
+  return false;
 }
 
 // A random image segment: midpoint uniform in the image, direction uniform, length uniform in
@@ -124,7 +123,7 @@ std::vector<LabelledLine> ModelLines(const WireframeModel& model, const Occlusio
   std::vector<LabelledLine> lines;
   for (const ProjectedEdge& edge :
        ProjectVisibleEdges(model, occlusion, CamFromWorld(truth), camera, projection)) {
-    for (const Segment2& piece : MeasuredPieces(edge.image, /*fragment=*/true, o, rng)) {
+    for (const Segment2& piece : MeasuredPieces(edge.image, true, o, rng)) {
       lines.push_back({piece, edge.edge_id, false});
     }
   }
@@ -210,11 +209,8 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
   const int vertical = static_cast<int>(std::lround(clutter * o.vertical_clutter_fraction));
   for (int k = 0; k < clutter; ++k) {
     LabelledLine line;
-    std::optional<Segment2> vertical_line;
-    if (k < vertical)
-      vertical_line = VerticalClutterLine(scene.truth, camera, occlusion, area, o, &rng);
-    line.vertical_clutter = vertical_line.has_value();
-    if (vertical_line) line.line = *vertical_line;
+    line.vertical_clutter = k < vertical && VerticalClutterLine(scene.truth, camera, occlusion,
+                                                                area, o, &rng, &line.line);
     if (line.vertical_clutter || RandomClutterLine(o, &rng, &line.line)) lines.push_back(line);
   }
   const double radius = o.delta_t * std::sqrt(rng.Uniform(0.0, 1.0));

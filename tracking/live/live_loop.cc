@@ -183,8 +183,8 @@ LiveIteration LiveLoop::Step() {
   }
   it.has_target = true;
   it.target = *target_;
-  it.servo =
-      servo_.Compute(it.t, cam_from_world * *target_, desired_px_, camera_, it.head, limits_);
+  it.servo = servo_.Compute(it.t, cam_from_world * *target_, desired_px_, camera_, it.head.pan,
+                            it.head.tilt, limits_);
   if (!it.servo.ok) {
     StopHead("servo: " + it.servo.reason, &it);
   } else {

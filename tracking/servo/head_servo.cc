@@ -114,8 +114,7 @@ void HeadServo::Reset() {
 
 ServoStep HeadServo::Compute(double t, const Eigen::Vector3d& target_cam,
                              const Eigen::Vector2d& desired_px, const CameraIntrinsics& camera,
-                             const HeadState& head, const HeadLimits& limits) {
-  const double pan = head.pan, tilt = head.tilt;
+                             double pan, double tilt, const HeadLimits& limits) {
   ServoStep step;
   Impl& m = *impl_;
   if (!(target_cam.z() > 1e-6) || !target_cam.allFinite()) {

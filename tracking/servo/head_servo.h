@@ -85,10 +85,10 @@ class HeadServo {
   HeadServo& operator=(const HeadServo&) = delete;
 
   // One iteration at time t (seconds): the target at `target_cam` (camera frame, from the pose),
-  // to be brought to `desired_px` of `camera` (undistorted model), the head at head.pan,
-  // head.tilt with `limits`. Never throws for ViSP failures (a result without command).
+  // to be brought to `desired_px` of `camera` (undistorted model), the head at (pan, tilt) with
+  // `limits`. Never throws for ViSP failures (a result without command).
   ServoStep Compute(double t, const Eigen::Vector3d& target_cam, const Eigen::Vector2d& desired_px,
-                    const CameraIntrinsics& camera, const HeadState& head,
+                    const CameraIntrinsics& camera, double pan, double tilt,
                     const HeadLimits& limits);
 
   // Forgets the hold state and the target-motion estimate (after a loss of tracking).

@@ -107,22 +107,12 @@ class PoseParameters {
   Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
 };
 
-// The state of the iteratively reweighted Gauss-Newton: the pose parameters, the residuals there
-// (pixels, one per edge point) and the information J^T W J there.
-struct IrlsSolution {
-  Eigen::VectorXd p, r;
-  Eigen::MatrixXd information;
-};
-
 // Iteratively reweighted Gauss-Newton (Huber weights) on the point-to-line distances of the edge
-// points of `edges`, from the parameters solution->p (updated; solution->r sized to the points).
-// False when an edge falls behind the camera or a step fails.
+// points of `edges`, from the parameters `p` (updated). `r` receives the residuals at the result
+// and `information` J^T W J there. False when an edge falls behind the camera or a step fails.
 bool SolveIrls(const std::vector<ViewedEdge>& edges, const CameraIntrinsics& camera,
                const PoseParameters& parameters, const EdgeRefinementOptions& options,
-               IrlsSolution* solution) {
-  Eigen::VectorXd* p = &solution->p;
-  Eigen::VectorXd* r = &solution->r;
-  Eigen::MatrixXd* information = &solution->information;
+               Eigen::VectorXd* p, Eigen::VectorXd* r, Eigen::MatrixXd* information) {
   const int dof = parameters.size();
   const int n = static_cast<int>(r->size());
   Eigen::VectorXd r_step(n), w(n);
@@ -192,20 +182,18 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
 
   const PoseParameters parameters(start, known);
   const int dof = parameters.size();
-  IrlsSolution solved;
-  Eigen::VectorXd& r = solved.r;
-  r.resize(out.points);
+  Eigen::VectorXd r(out.points);
   if (!Residuals(used, camera, start, &r)) return out;
   out.rms_before_px = Rms(r);
 
-  Eigen::VectorXd& p = solved.p;
-  const Eigen::MatrixXd& information = solved.information;
+  Eigen::VectorXd p;
+  Eigen::MatrixXd information;
   for (int rejections = 0;; ++rejections) {
     const int n = PointCount(used);
     if (n < options.min_points) return out;
     p = Eigen::VectorXd::Zero(dof);
     r.resize(n);
-    if (!SolveIrls(used, camera, parameters, options, &solved)) return out;
+    if (!SolveIrls(used, camera, parameters, options, &p, &r, &information)) return out;
     if (rejections == options.max_edge_rejections) break;
     const std::vector<double> means = EdgeMeanResiduals(used, r);
     int worst = -1;
