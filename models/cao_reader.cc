@@ -168,11 +168,11 @@ class Parser {
     Eigen::Isometry3d file_from_include = Eigen::Isometry3d::Identity();
     const std::string params = joined.substr(q2 + 1);
     Eigen::Vector3d t;
-    if (ReadVectorParam(params, "t=[", line.number, &t, false)) {
+    if (ReadVectorParam(params, "t=[", line.number, &t, /*angles=*/false)) {
       file_from_include.translation() = t;
     }
     Eigen::Vector3d tu;
-    if (ReadVectorParam(params, "tu=[", line.number, &tu, true) && tu.norm() > 0.0) {
+    if (ReadVectorParam(params, "tu=[", line.number, &tu, /*angles=*/true) && tu.norm() > 0.0) {
       file_from_include.linear() = Eigen::AngleAxisd(tu.norm(), tu.normalized()).toRotationMatrix();
     }
     if (!read_include_) Fail(line.number, "includes are not allowed here");

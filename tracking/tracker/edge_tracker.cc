@@ -78,7 +78,7 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
   }
   try {
     ScopedStdoutSilencer silence;
-    tracker->loadModel(model_path, false);
+    tracker->loadModel(model_path, /*verbose=*/false);
   } catch (const vpException& e) {
     throw InputError(
         Located(model_path, 0, std::string("ViSP cannot load the model: ") + e.getMessage()));
