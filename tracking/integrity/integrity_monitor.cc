@@ -100,6 +100,22 @@ std::string Fixed(double value, int digits) {
   return out.str();
 }
 
+// Widens the levels and the covariance of `out` to bound the error of `start` rather than of the
+// solution: |e_start| <= |e_solution| + |start - solution| in position and in rotation angle.
+void BoundStartPose(const Eigen::Isometry3d& start, PoseIntegrity* out) {
+  const Eigen::Isometry3d& solution = out->solution.cam_from_world;
+  const Eigen::Vector3d centre_start = -(start.linear().transpose() * start.translation());
+  const Eigen::Vector3d centre_solution = -(solution.linear().transpose() * solution.translation());
+  Eigen::Vector3d d_centre = centre_start - centre_solution;
+  if (BlocksOf(out->solution.parameters).position_size == 2) d_centre.z() = 0.0;
+  const double d_rotation =
+      Eigen::AngleAxisd(start.linear() * solution.linear().transpose()).angle();
+  out->levels.position_m += d_centre.norm();
+  out->levels.rotation_rad += d_rotation;
+  out->world_covariance.topLeftCorner<3, 3>() += d_centre * d_centre.transpose();
+  out->world_covariance.bottomRightCorner<3, 3>().diagonal().array() += d_rotation * d_rotation;
+}
+
 // The status and reason of a solution that passed the fault test.
 void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
   const ProtectionLevels& pl = out->levels;
@@ -332,6 +348,7 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
   const Eigen::Vector2d sigmas = LargestSigmas(parameters, out.covariance);
   out.position_sigma_m = sigmas[0];
   out.rotation_sigma_rad = sigmas[1];
+  if (options.bound_start_pose) BoundStartPose(start, &out);
   Judge(options, &out);
   return out;
 }

@@ -40,6 +40,10 @@ struct IntegrityOptions {
   double fault_sigma_px = 3.0;
   int max_exclusions = 2;  // edges the fault test may exclude before the pose is lost
   int min_edges = 3;
+  // true: the levels bound the error of the start pose (the tracker's own, which is reported)
+  // rather than the solution's: each level grows by the two poses' separation (triangle
+  // inequality), and the covariance by its outer product.
+  bool bound_start_pose = false;
 
   bool Check(std::string* why) const;
 };

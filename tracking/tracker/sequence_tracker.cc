@@ -217,15 +217,15 @@ void SequenceTracker::Assess(const std::vector<EdgeObservation>& observations,
     u.reason = "no edge points bound the pose (sub-pixel refinement not applied)";
     return;
   }
+  // The tracker's pose is reported (it is the one the next frame starts from); the levels bound
+  // its error.
+  IntegrityOptions options = options_.integrity;
+  options.bound_start_pose = true;
   const PoseIntegrity integrity =
       EvaluatePoseIntegrity(observations, tracker_->camera(), *report->cam_from_world,
-                            PoseParameterisation(Known(robot)), options_.integrity);
+                            PoseParameterisation(Known(robot)), options);
   u = UncertaintyOf(integrity);
-  if (integrity.status == IntegrityStatus::kLost) {
-    report->cam_from_world.reset();
-  } else {
-    report->cam_from_world = integrity.solution.cam_from_world;
-  }
+  if (integrity.status == IntegrityStatus::kLost) report->cam_from_world.reset();
 }
 
 bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robot,
