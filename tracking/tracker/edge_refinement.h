@@ -98,7 +98,7 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
 // Gauss-Newton refinement.
 struct EdgeAlignmentOptions {
   double sample_step_px = 6.0;  // distance between searches along a projected edge
-  double search_px = 12.0;      // first round's half search length
+  double search_px = 12.0;      // the first search pass: half its length
   int rounds = 2;
   EdgeRefinementOptions solve;  // later rounds search solve.search_px
 
