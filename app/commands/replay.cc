@@ -27,6 +27,7 @@
 #include "tracking/capture/video_source.h"
 #include "tracking/tracker/pose_file.h"
 #include "tracking/tracker/robot_readings.h"
+#include "tracking/tracker/tracking_engine.h"
 
 namespace linetrack::app {
 namespace {
@@ -254,30 +255,24 @@ class Progress {
 class ReplayTracking {
  public:
   ReplayTracking(const ReplayOptions& opt, const ReplaySetup& s)
-      : camera_(s.camera),
-        loaded_(cache_.Model(opt.model)),
-        tracker_(opt.model, s.camera, s.settings) {
+      : camera_(s.camera), loaded_(cache_.Model(opt.model)) {
+    TrackingEngineOptions options;
+    options.matcher.noise = DetectedLineNoise();  // lines from LineExtractor
+    options.lines = opt.lines.Options();
+    options.relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
+    options.settings = s.settings;
+    options.sequence.integrity = opt.integrity.Options();
+    TrackingEngineModel model{opt.model, nullptr, nullptr, nullptr};
     if (s.robot) {
-      LocalizerOptions matcher;
-      matcher.noise = DetectedLineNoise();  // lines from LineExtractor
-      localizer_ = std::make_unique<Localizer>(*loaded_.model, loaded_.regions.get(),
-                                               loaded_.area.get(), s.camera, matcher);
-      RelocalizationOptions relocalization;
-      relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
-      // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
-      relocalizer_ = std::make_unique<Relocalizer>(
-          *localizer_, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
+      model = {opt.model, loaded_.model.get(), loaded_.regions.get(), loaded_.area.get()};
     }
-    SequenceTrackerOptions sequence_options;
-    sequence_options.integrity = opt.integrity.Options();
-    sequence_ = std::make_unique<SequenceTracker>(&tracker_, s.camera, relocalizer_.get(),
-                                                  sequence_options);
-    if (s.start_pose) sequence_->SetStartPose(*s.start_pose);
-    if (s.initial_prior) sequence_->SetInitialPrior(*s.initial_prior);
+    engine_ = std::make_unique<TrackingEngine>(model, s.camera, options);
+    if (s.start_pose) engine_->sequence().SetStartPose(*s.start_pose);
+    if (s.initial_prior) engine_->sequence().SetInitialPrior(*s.initial_prior);
     occlusion_ = std::make_unique<OcclusionTester>(*loaded_.model);
   }
 
-  SequenceTracker& sequence() { return *sequence_; }
+  SequenceTracker& sequence() { return engine_->sequence(); }
 
   // The model edges visible at `cam_from_world`, in pixels of the undistorted frame.
   std::vector<Segment2> VisibleEdges(const Eigen::Isometry3d& cam_from_world) const {
@@ -293,10 +288,7 @@ class ReplayTracking {
   CameraIntrinsics camera_;
   LocalizerCache cache_{LocalizerOptions()};
   const LoadedModel& loaded_;
-  EdgeTracker tracker_;
-  std::unique_ptr<Localizer> localizer_;
-  std::unique_ptr<Relocalizer> relocalizer_;
-  std::unique_ptr<SequenceTracker> sequence_;
+  std::unique_ptr<TrackingEngine> engine_;
   std::unique_ptr<OcclusionTester> occlusion_;
 };
 

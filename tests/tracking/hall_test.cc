@@ -15,7 +15,9 @@
 #include "models/render/sequence.h"
 #include "models/view_invariant_regions.h"
 #include "tracking/integrity/consistency.h"
+#include "tracking/live/tracker_estimator.h"
 #include "tracking/tracker/sequence_tracker.h"
+#include "tracking/tracker/tracking_engine.h"
 
 namespace linetrack {
 namespace {
@@ -271,6 +273,39 @@ TEST(HallSequence, AReLocalisationAwayFromTheOdometryIsNeverTracking) {
   for (int i = back; i < kFrames; ++i)
     tracking_after += control.reports[i].uncertainty.status == IntegrityStatus::kTracking;
   EXPECT_GT(tracking_after, 0) << "the re-localisation without the slip is never confirmed";
+}
+
+// Replay drives the tracking engine with each frame's reading; live drives it through the live
+// loop's estimator with each frame's camera prior. The same frames and readings give the same
+// statuses, poses and uncertainties.
+TEST(TrackingEngine, ReplayAndLiveGiveTheSameStatusesAndPoses) {
+  const HallData& hall = Hall();
+  const NavigableArea area = NavigableArea::FromModel(hall.model);
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(hall.model, area);
+  TrackingEngineOptions options;
+  options.matcher.noise = DetectedLineNoise();
+  TrackingEngine replay({kSource + "/models/hall.cao", &hall.model, &regions, &area}, hall.camera,
+                        options);
+  TrackerPoseEstimator live(hall.model, area, hall.camera, options);
+  constexpr int kCompared = 25;
+  int with_pose = 0;
+  for (int i = 0; i < kCompared; ++i) {
+    const RobotPose& prior = hall.priors[i].pose;
+    const FrameReport r = replay.Process(hall.images[i], hall.frames[i].t, RobotReadingOf(prior));
+    Frame frame;
+    frame.image = hall.images[i];
+    frame.timestamp_s = hall.frames[i].t;
+    const PoseEstimate e = live.Estimate(frame, HeadState(), prior);
+    EXPECT_EQ(e.status, PoseStatusOf(r.status)) << "frame " << i;
+    EXPECT_EQ(e.uncertainty.status, r.uncertainty.status) << "frame " << i;
+    ASSERT_EQ(e.cam_from_world.has_value(), r.cam_from_world.has_value()) << "frame " << i;
+    if (!r.cam_from_world) continue;
+    ++with_pose;
+    EXPECT_TRUE(e.cam_from_world->isApprox(*r.cam_from_world, 1e-12)) << "frame " << i;
+    EXPECT_TRUE(e.uncertainty.world_covariance.isApprox(r.uncertainty.world_covariance, 1e-12))
+        << "frame " << i;
+  }
+  EXPECT_GE(with_pose, kCompared / 2);
 }
 
 }  // namespace
