@@ -3,6 +3,7 @@
 #pragma once
 
 #include "app/cli_common.h"
+#include "app/recording.h"
 
 namespace linetrack::app {
 
@@ -18,7 +19,8 @@ void AddBenchLines(CLI::App& cli, CommandAction* action);
 void AddLines(CLI::App& cli, CommandAction* action);
 void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
-void AddReplay(CLI::App& cli, CommandAction* action);
+// `replay`; `open_recording` reads rosbag inputs (empty: videos and image sequences only).
+void AddReplay(CLI::App& cli, CommandAction* action, RecordingOpener open_recording = {});
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 

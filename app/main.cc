@@ -11,6 +11,8 @@
 #include <opencv2/core/version.hpp>
 
 #include "app/commands.h"
+#include "app/ros/bag_recording.h"
+#include "app/ros/ros_commands.h"
 #include "models/errors.h"
 
 namespace {
@@ -55,9 +57,11 @@ int main(int argc, char** argv) {
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
-  app::AddReplay(cli, &action);
+  app::AddReplay(cli, &action, app::OpenRosBag);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddRos(cli, &action);
+  app::AddBenchRos(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -240,6 +240,7 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       for (int k = 0; k < 6; ++k)
         c(r, k) = covariance[r][k];
     }
+    result.covariance = c;
     const Eigen::Vector2d sigmas = CovarianceSigmas(c);
     health.position_sigma_m = sigmas.x();
     health.rotation_sigma_deg = vpMath::deg(sigmas.y());

@@ -34,6 +34,9 @@ struct EdgeTrackResult {
   double passes_ms = 0.0;   // Track(): wall clock in ViSP's track() calls
   double measure_ms = 0.0;  // Track(): projection error read, moving-edge states, refinement,
                             // covariance
+  // Track() with_covariance: ViSP's covariance of the pose parameters (t, theta u) of cMo
+  // (vpMbTracker::getCovarianceMatrix), of ViSP's pose before the sub-pixel refinement.
+  std::optional<Eigen::Matrix<double, 6, 6>> covariance;
 };
 
 // RMS image motion (pixels) of the model `edges` (world) between two poses: the edges are clipped

@@ -142,6 +142,7 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
     recent_refined_rms_.pop_front();
   last_good_index_ = frame_index_;
   report->cam_from_world = result.cam_from_world;
+  report->covariance = result.covariance;
   report->source = source;
   report->note.clear();
 }
@@ -166,6 +167,7 @@ bool SequenceTracker::StartAndVerify(const Eigen::Isometry3d& candidate, double 
   }
   following_ = true;
   report->cam_from_world = result.cam_from_world;
+  report->covariance = result.covariance;
   return true;
 }
 
@@ -225,7 +227,8 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     const Clock::time_point track_start = Clock::now();
     MaybePredict(robot, &report);
     report.predict_ms = MillisecondsSince(track_start);
-    const EdgeTrackResult result = tracker_->Track(*undistorted_, false, Known(robot));
+    const EdgeTrackResult result =
+        tracker_->Track(*undistorted_, options_.covariance_every_frame, Known(robot));
     report.track_ms = MillisecondsSince(track_start);
     report.passes_ms = result.passes_ms;
     report.measure_ms = result.measure_ms;
@@ -286,6 +289,7 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     EdgeTrackResult accepted;
     accepted.ok = true;
     accepted.cam_from_world = pose;
+    accepted.covariance = report.covariance;
     accepted.health = report.health;
     Accept(accepted, t, robot, source, &report);
     report.status = had_pose ? TrackStatus::kRelocalised : TrackStatus::kTracking;
@@ -293,6 +297,7 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   } else {
     report.status = had_pose ? TrackStatus::kLost : TrackStatus::kInitialising;
     report.cam_from_world.reset();
+    report.covariance.reset();
   }
   report.total_ms = MillisecondsSince(start);
   return report;

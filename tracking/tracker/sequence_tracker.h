@@ -69,6 +69,9 @@ struct SequenceTrackerOptions {
   // poses of the live drive test (0.34-0.42 px after 0.16-0.19): docs/tracking.md.
   double rms_jump_ratio = 2.5;
   double rms_jump_floor_px = 0.3;
+  // ViSP's pose covariance on every tracked frame (FrameReport::covariance), not only when a
+  // candidate pose is verified: a dense n x n weight matrix over the n moving edges.
+  bool covariance_every_frame = false;
 
   bool Check(std::string* why) const;
 };
@@ -89,6 +92,8 @@ struct FrameReport {
   std::string note;    // why there is no pose (empty otherwise)
   int lines = -1;      // segments extracted when the matcher ran, else -1
   bool predicted = false;  // tracking started from the odometry's prediction
+  // ViSP's covariance of (t, theta u) of cMo when computed on this frame (EdgeTrackResult).
+  std::optional<Eigen::Matrix<double, 6, 6>> covariance;
   double undistort_ms = 0.0;
   double track_ms = 0.0;       // tracking from the previous frame, of which:
   double predict_ms = 0.0;     //   the odometry's prediction and its alignment on the edges
