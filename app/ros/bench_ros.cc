@@ -135,7 +135,8 @@ int RunBenchRos(const BenchRosOptions& opt) {
             << done.dropped << " dropped, " << done.processed << " tracked, " << done.with_pose
             << " poses\n";
   PrintQuantiles("tracking step", done.track_ms);
-  PrintQuantiles("arrival to pose published, beyond the tracking step", done.overhead_ms);
+  PrintQuantiles("taken to pose published, beyond the tracking step", done.overhead_ms);
+  PrintQuantiles("waiting for the worker after arrival", done.wait_ms);
   return done.with_pose > 0 ? kExitOk : kExitJobFailed;
 }
 

@@ -60,9 +60,10 @@ int RunRos(RosCommandOptions opt) {
   std::cout << "ros: " << stats.received << " images, " << stats.dropped << " dropped, "
             << stats.processed << " tracked, " << stats.with_pose << " poses published";
   if (!stats.overhead_ms.empty()) {
-    std::cout << "; latency beyond the tracking step median "
-              << QuantileNearestRank(stats.overhead_ms, 0.5) << " ms, p95 "
-              << QuantileNearestRank(stats.overhead_ms, 0.95) << " ms";
+    std::cout << "; beyond the tracking step median " << QuantileNearestRank(stats.overhead_ms, 0.5)
+              << " ms, p95 " << QuantileNearestRank(stats.overhead_ms, 0.95)
+              << " ms; waiting for the worker median " << QuantileNearestRank(stats.wait_ms, 0.5)
+              << " ms";
   }
   std::cout << std::endl;
   return kExitOk;

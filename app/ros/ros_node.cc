@@ -146,7 +146,7 @@ struct RosNode::Impl {
   bool EnsureTracker();
   CameraMount MountNow() const;
   void ApplyStart();
-  void Process(const PendingImage& image);
+  void Process(const PendingImage& image, Clock::time_point taken);
   void Publish(const TrackedFrame& out, const std_msgs::Header& header,
                const std::optional<Eigen::Isometry3d>& odom_from_base);
   void PublishOverlay(const TrackedFrame& out, const std_msgs::Header& header);
@@ -298,7 +298,7 @@ void RosNode::Impl::ApplyStart() {
            RadToDeg(bounds.delta_phi));
 }
 
-void RosNode::Impl::Process(const PendingImage& image) {
+void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) {
   const std_msgs::Header& header = image.msg->header;
   vpImage<unsigned char> grey;
   try {
@@ -327,18 +327,20 @@ void RosNode::Impl::Process(const PendingImage& image) {
   if (odom) input.odom_base = PlanarOf(*odom);
   const TrackedFrame out = tracker->Process(grey, input);
   Publish(out, header, odom);
-  const double total_ms =
-      std::chrono::duration<double, std::milli>(Clock::now() - image.arrival).count();
+  const double busy_ms = std::chrono::duration<double, std::milli>(Clock::now() - taken).count();
+  const double wait_ms = std::chrono::duration<double, std::milli>(taken - image.arrival).count();
   {
     std::lock_guard<std::mutex> lock(mutex);
     ++stats.processed;
     if (out.map_from_base) ++stats.with_pose;
     stats.track_ms.push_back(out.track_ms);
-    stats.overhead_ms.push_back(total_ms - out.track_ms);
+    stats.overhead_ms.push_back(busy_ms - out.track_ms);
+    stats.wait_ms.push_back(wait_ms);
     if (stats.track_ms.size() > kMaxTimings) {  // the most recent half is kept
       stats.track_ms.erase(stats.track_ms.begin(), stats.track_ms.begin() + kMaxTimings / 2);
       stats.overhead_ms.erase(stats.overhead_ms.begin(),
                               stats.overhead_ms.begin() + kMaxTimings / 2);
+      stats.wait_ms.erase(stats.wait_ms.begin(), stats.wait_ms.begin() + kMaxTimings / 2);
     }
     last_status = out.status;
     last_note = out.note;
@@ -403,7 +405,8 @@ void RosNode::Run() {
       if (m.stop) break;
       image.swap(m.pending);
     }
-    if (image && m.EnsureTracker()) m.Process(*image);
+    const Clock::time_point taken = Clock::now();
+    if (image && m.EnsureTracker()) m.Process(*image, taken);
     m.updater.update();
   }
 }

@@ -51,10 +51,12 @@ struct RosNodeStats {
   long dropped = 0;   // replaced while waiting (the oldest first)
   long processed = 0;
   long with_pose = 0;
-  // The last frames' (at most 100000): the tracking step, and the time from the image's arrival
-  // to its pose published minus the tracking step.
+  // The last frames' (at most 100000): the tracking step; the time from the worker taking the
+  // image to its pose published, minus the tracking step (conversion, odometry, publishing); the
+  // time the image waited for the worker after its arrival (the frame before it being tracked).
   std::vector<double> track_ms;
   std::vector<double> overhead_ms;
+  std::vector<double> wait_ms;
 };
 
 class RosNode {
