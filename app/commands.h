@@ -19,6 +19,7 @@ void AddBenchLines(CLI::App& cli, CommandAction* action);
 void AddLines(CLI::App& cli, CommandAction* action);
 void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
+void AddBenchDrive(CLI::App& cli, CommandAction* action);
 // `replay`; `open_recording` reads rosbag inputs (empty: videos and image sequences only).
 void AddReplay(CLI::App& cli, CommandAction* action, RecordingOpener open_recording = {});
 void AddLive(CLI::App& cli, CommandAction* action);

@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
+  app::AddBenchDrive(cli, &action);
   app::AddReplay(cli, &action, app::OpenRosBag);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
