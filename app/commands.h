@@ -20,8 +20,9 @@ void AddLines(CLI::App& cli, CommandAction* action);
 void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
 void AddBenchDrive(CLI::App& cli, CommandAction* action);
-// `replay`; `open_recording` reads rosbag inputs (empty: videos and image sequences only).
-void AddReplay(CLI::App& cli, CommandAction* action, RecordingOpener open_recording = {});
+// `replay` of videos and image sequences; with `open_recording`, also of rosbag files.
+void AddReplay(CLI::App& cli, CommandAction* action);
+void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpener open_recording);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 

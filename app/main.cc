@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
   app::AddBenchDrive(cli, &action);
-  app::AddReplay(cli, &action, app::OpenRosBag);
+  app::AddReplayWithRecordings(cli, &action, app::OpenRosBag);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
   app::AddRos(cli, &action);

@@ -427,7 +427,11 @@ int RunReplay(const ReplayOptions& opt) {
 
 }  // namespace
 
-void AddReplay(CLI::App& cli, CommandAction* action, RecordingOpener open_recording) {
+void AddReplay(CLI::App& cli, CommandAction* action) {
+  AddReplayWithRecordings(cli, action, {});
+}
+
+void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpener open_recording) {
   auto opt = std::make_shared<ReplayOptions>();
   opt->open_recording = std::move(open_recording);
   CLI::App* cmd = cli.add_subcommand(
