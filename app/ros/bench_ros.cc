@@ -41,7 +41,7 @@ struct Drive {
 
 Drive RenderDrive(const BenchRosOptions& opt) {
   const WireframeModel model = WireframeModel::Load(opt.model);
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera);
+  const CameraIntrinsics camera = LoadCamera(opt.camera);
   NavigableAreaOptions nav;
   nav.sidecar_path = opt.nav;
   const NavigableArea area = NavigableArea::FromModel(model, nav);
@@ -149,7 +149,7 @@ void AddBenchRos(CLI::App& cli, CommandAction* action) {
       "Latency of `linetrack ros` from an image's arrival to its pose published, beyond the "
       "tracking step, on a rendered drive (roscore of its own on a free port)");
   cmd->add_option("--model", opt->model, "ViSP .cao model")->required();
-  cmd->add_option("--camera", opt->camera, "ViSP camera XML")->required();
+  cmd->add_option("--camera", opt->camera, "Camera file: ViSP XML, OpenCV or ROS YAML")->required();
   cmd->add_option("--nav", opt->nav, "Navigable-area sidecar (.nav.json) for the drive");
   cmd->add_option("--frames", opt->frames, "Frames of the drive")->capture_default_str();
   cmd->add_option("--rate", opt->rate, "Images per second (0: the next once the last is done)")

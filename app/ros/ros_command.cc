@@ -86,7 +86,8 @@ void AddRos(CLI::App& cli, CommandAction* action) {
     });
   };
   flag("--model", "model", &o.model, "ViSP .cao model (parameter ~model); its frame is the map");
-  flag("--camera", "camera", &o.camera, "ViSP camera XML (~camera); default: from camera_info");
+  flag("--camera", "camera", &o.camera,
+       "Camera file: ViSP XML, OpenCV or ROS YAML (~camera); default: camera_info");
   flag("--settings", "settings", &o.settings, "ViSP tracker XML (~settings)");
   flag("--map-frame", "map_frame", &o.map_frame, "Map frame (~map_frame, default map)");
   flag("--odom-frame", "odom_frame", &o.odom_frame, "Odometry frame (~odom_frame, default odom)");
@@ -102,11 +103,9 @@ void AddRos(CLI::App& cli, CommandAction* action) {
        "default 0.10,2)");
   flag("--transform-tolerance", "transform_tolerance", &o.transform_tolerance,
        "Seconds added to the stamp of map -> odom, as AMCL (~transform_tolerance, default 0.1)");
-  cmd->allow_extras();
-  cmd->callback([opt, cmd, action] {
-    opt->ros_args = cmd->remaining();
-    *action = [opt] { return RunRos(*opt); };
-  });
+  // Remappings are positional, so that unknown flags still reach the global ones (-q).
+  cmd->add_option("remappings", opt->ros_args, "ROS remappings name:=value (__name, __log, ...)");
+  cmd->callback([opt, action] { *action = [opt] { return RunRos(*opt); }; });
 }
 
 }  // namespace linetrack::app

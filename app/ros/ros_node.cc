@@ -160,7 +160,7 @@ void RosNode::Impl::Setup() {
   tracker_options.alert_position_m = options.alert_position_m;
   tracker_options.alert_yaw_rad = DegToRad(options.alert_yaw_deg);
   if (!options.camera.empty()) {
-    tracker_options.camera = ReadCameraXml(options.camera);
+    tracker_options.camera = LoadCamera(options.camera);
     if (tracker_options.camera.width <= 0) {
       throw InputError(options.camera + ": the camera file gives no image size");
     }
