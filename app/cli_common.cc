@@ -2,11 +2,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #include <spdlog/fmt/fmt.h>
@@ -55,6 +57,18 @@ void CheckRange(double value, double lo, double hi, const std::string& flag) {
     msg << flag << ": " << value << " is outside [" << lo << ", " << hi << "]";
     throw InputError(msg.str());
   }
+}
+
+void CheckTimesOverlap(const std::vector<double>& times, double first, double last,
+                       double tolerance, const std::string& what) {
+  if (times.empty()) return;
+  const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+  if (*hi >= first - tolerance && *lo <= last + tolerance) return;
+  std::ostringstream msg;
+  msg << std::fixed << std::setprecision(3) << what << ": its times " << *lo << "-" << *hi
+      << " s do not overlap the frames' times " << first << "-" << last
+      << " s (give --time-offset SECONDS, or --align-times)";
+  throw InputError(msg.str());
 }
 
 void CheckHeight(double metres, const std::string& flag) {

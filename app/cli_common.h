@@ -36,6 +36,12 @@ std::vector<double> ParseNumbers(const std::string& text, int count, const std::
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
 void CheckRange(double value, double lo, double hi, const std::string& flag);
 
+// Throws InputError (naming `what`, e.g. "x.csv: --prior-file") unless some of `times` (seconds,
+// already shifted by any --time-offset) fall within [first - tolerance, last + tolerance], the
+// frames' times: a file stamped in another time base (epoch seconds against frames from 0).
+void CheckTimesOverlap(const std::vector<double>& times, double first, double last,
+                       double tolerance, const std::string& what);
+
 // Throws InputError unless `metres` is a camera height above the floor: finite, positive and at
 // most 100 m (names `flag`).
 void CheckHeight(double metres, const std::string& flag);

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/integrity_output.h"
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
@@ -49,6 +50,7 @@ struct LiveCommandOptions {
   bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
   double camera_fps = 0.0;
+  IntegrityFlags integrity;
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -211,6 +213,7 @@ class LiveFiles {
       throw InputError(opt.prior_file + ": no prior rows");
     }
     inputs_.tracker.matcher.noise = DetectedLineNoise();
+    inputs_.tracker.sequence.integrity = opt.integrity.Options();
     if (!opt.settings.empty()) inputs_.tracker.settings = ReadTrackerSettings(opt.settings);
     if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
         plan.sim_camera.render_options.scene.clutter > 0) {
@@ -288,6 +291,7 @@ struct LiveRunEnd {
   std::string stop_reason = "duration";
   HeadResult stopped;          // the head's stop at the end
   std::exception_ptr failure;  // an error in the middle of the run, rethrown after the files
+  IntegrityTally integrity;    // statuses and sigmas, with a simulator's truth the failures
 };
 
 // Steps the loop until the duration, the end of the source, a signal or an error; then stops
@@ -319,6 +323,12 @@ LiveRunEnd RunLoop(const LivePlan& plan, LiveSession* session, LiveViews* views,
         spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
       }
       output->Add(it, session->truth());
+      std::optional<IntegrityCheck> check;
+      if (it.estimate.has_pose() && session->truth() != nullptr) {
+        check = CheckAgainstTruth(it.estimate.uncertainty, *it.estimate.cam_from_world,
+                                  *session->truth(), /*robot=*/true);
+      }
+      end.integrity.Add(it.estimate.uncertainty, check);
       views->Show(it, loop, output);
       if (max_frames > 0 && end.summary.frames >= max_frames) break;
       if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
@@ -335,7 +345,8 @@ LiveRunEnd RunLoop(const LivePlan& plan, LiveSession* session, LiveViews* views,
 }
 
 // summary.json of the run: the loop's figures, how it stopped, what it ran on.
-nlohmann::ordered_json RunSummaryJson(const LiveRunEnd& end, LiveSession& session) {
+nlohmann::ordered_json RunSummaryJson(const LiveRunEnd& end, LiveSession& session,
+                                      const IntegrityOptions& integrity) {
   nlohmann::ordered_json json = SummaryJson(end.summary, end.stop_reason);
   json["head_stopped_at_end"] = end.stopped.ok();
   json["source"] = session.DescribeSource();
@@ -344,6 +355,7 @@ nlohmann::ordered_json RunSummaryJson(const LiveRunEnd& end, LiveSession& sessio
   LiveLoop& loop = session.loop();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
+  json["integrity"] = end.integrity.Summary(integrity);
   return json;
 }
 
@@ -351,12 +363,12 @@ int RunLive(const LiveCommandOptions& opt) {
   const LivePlan plan = CheckFlags(opt);
   const LiveFiles files(opt, plan);
   LiveSession session(plan, files.inputs());
-  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr);
+  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr, opt.integrity.all_poses);
   spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
                session.DescribeHead(), session.DescribeEstimator(), plan.duration);
   LiveViews views(opt, files.model(), files.inputs().camera);
   const LiveRunEnd end = RunLoop(plan, &session, &views, &output);
-  output.Finish(RunSummaryJson(end, session));
+  output.Finish(RunSummaryJson(end, session, files.inputs().tracker.sequence.integrity));
   if (end.failure) std::rethrow_exception(end.failure);
   std::cout << "live: " << end.summary.frames << " frames, " << end.summary.with_pose
             << " with a pose, final error " << end.summary.final_error_px << " px, stopped by "
@@ -414,6 +426,8 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                   "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
+  AddIntegrityFlags(cmd, &opt->integrity);
+  AddAllPosesFlag(cmd, &opt->integrity);
   cmd->add_option("--camera-fps", opt->camera_fps,
                   "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {

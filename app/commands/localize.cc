@@ -11,11 +11,14 @@
 
 #include "app/commands.h"
 #include "app/image_overlay.h"
+#include "app/integrity_output.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
+#include "tracking/integrity/image_pose_check.h"
+#include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/relocalizer.h"
 
 namespace linetrack::app {
@@ -36,7 +39,49 @@ struct LocalizeOptions {
   // the relative focal-length error of the camera file (default the paper's 2 %).
   std::string line_noise;
   double focal_error = LineNoise().focal_relative;
+  // With --image: the answer's covariance and protection levels (its alert limit and the
+  // calibration and model uncertainty).
+  IntegrityFlags integrity;
 };
+
+// The integrity of the matcher's answer on its image: the moving edges and their sub-pixel points
+// at the answer (known height and tilt).
+PoseUncertainty CheckAnswer(const LocalizeOptions& opt, const ImageLines& image,
+                            const LocalizationProblem& problem, const LocalizationResult& result,
+                            const IntegrityOptions& options) {
+  CameraIntrinsics camera = image.camera;
+  if (camera.width <= 0) {  // a camera file without the image size: the image's
+    camera.width = static_cast<int>(image.image.getWidth());
+    camera.height = static_cast<int>(image.image.getHeight());
+  }
+  EdgeTracker tracker(opt.model_path, camera, TrackerSettings());
+  ImageUndistorter undistorter(camera);
+  return UncertaintyOf(CheckPoseOnImage(&tracker, undistorter.Apply(image.image),
+                                        result.cam_from_world,
+                                        KnownHeightTilt{problem.height, problem.tilt}, options));
+}
+
+// An answer whose protection levels exceed the alert limit is no answer: "ambiguous" when the
+// matcher compared rivals (listed), else "none"; the candidate stays in the JSON with its
+// covariance.
+void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
+                    nlohmann::ordered_json* json) {
+  (*json)["found"] = false;
+  (*json)["answer"] = result.finalists.size() > 1 ? "ambiguous" : "none";
+  (*json)["reason"] = "the answer is not within the alert limit: " + u.reason;
+  (*json)["candidate"] = (*json)["pose"];
+  (*json)["pose"] = nullptr;
+  (*json)["cMo"] = nullptr;
+  nlohmann::ordered_json rivals = nlohmann::ordered_json::array();
+  for (const Finalist& f : result.finalists) {
+    rivals.push_back({{"x", f.pose.x},
+                      {"y", f.pose.y},
+                      {"heading_deg", RadToDeg(WrapAngle(f.pose.heading))},
+                      {"matched_edges", f.matched_edges},
+                      {"mean_distance_px", f.mean_distance_px}});
+  }
+  (*json)["rivals"] = rivals;
+}
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
@@ -150,6 +195,7 @@ int RunSingle(const LocalizeOptions& opt) {
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
+  const IntegrityOptions integrity_options = opt.integrity.Options();
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
   const auto start = std::chrono::steady_clock::now();
@@ -160,6 +206,12 @@ int RunSingle(const LocalizeOptions& opt) {
     result = localizer.Localize(problem);
   }
   const double ms = Milliseconds(start);
+  std::optional<PoseUncertainty> integrity;
+  if (image && result.found) {
+    integrity = CheckAnswer(opt, *image, problem, result, integrity_options);
+  }
+  const bool answered =
+      result.found && (!integrity || integrity->status == IntegrityStatus::kTracking);
   if (image && !opt.overlay_path.empty()) {
     WriteFileAtomically(
         opt.overlay_path,
@@ -176,11 +228,28 @@ int RunSingle(const LocalizeOptions& opt) {
       json["lines"] = image->segments.size();
       json["lines_ms"] = image->ms;
     }
+    if (integrity) {
+      json["integrity"] = UncertaintyJson(*integrity);
+      if (!answered) WithholdAnswer(result, *integrity, &json);
+    }
     std::cout << json.dump(2) << std::endl;
+  } else if (result.found && !answered) {
+    std::cout << "no answer: the pose found (x " << std::fixed << std::setprecision(3)
+              << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading))
+              << " deg) is not within the alert limit: " << integrity->reason << " ("
+              << result.finalists.size() << " rivals)\n";
   } else {
     PrintResult(result, *cache.Model(opt.model_path).model, ms);
+    if (integrity && result.found) {
+      std::cout << std::fixed << std::setprecision(3) << "integrity " << ToString(integrity->status)
+                << ": sigma x " << integrity->sigma_x_m << " m, y " << integrity->sigma_y_m
+                << " m, heading " << RadToDeg(integrity->sigma_heading_rad) << " deg; protection "
+                << integrity->protection_position_m << " m, "
+                << RadToDeg(integrity->protection_rotation_rad) << " deg\n";
+    }
   }
-  return result.found ? kExitOk : kExitJobFailed;
+  return answered ? kExitOk : kExitJobFailed;
 }
 
 }  // namespace
@@ -216,6 +285,7 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
   cmd->add_flag("--json", opt->json, "Print the result as JSON (the batch format)");
+  AddIntegrityFlags(cmd, &opt->integrity);
   cmd->add_option("--batch", opt->batch_path,
                   "JSON-lines file of cases; prints one JSON result per line, in order");
   cmd->add_option("--method", opt->method, "tree (default) or baseline (hypothesise-and-test)")

@@ -5,15 +5,18 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/integrity_output.h"
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
@@ -38,9 +41,12 @@ struct ReplayOptions {
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
   double fps = 0.0;
+  double time_offset = 0.0;  // seconds added to the frames' times to read priors, ground truth
+  bool align_times = false;  // time_offset = first prior (or ground-truth) time - first frame's
   long max_frames = 0;
   bool overlay_png = false, no_overlay = false, scanline = false;
   LineFlags lines;             // the line extractor of the re-localisation
+  IntegrityFlags integrity;    // the alert limit and the sigmas of the pose integrity
   RecordingOptions recording;  // a rosbag input (--image-topic ...)
   RecordingOpener open_recording;
 };
@@ -108,6 +114,7 @@ struct ReplaySetup {
   long frame_count = 0;
   Frame first;
   double fps = 30.0;
+  double time_offset = 0.0;  // --time-offset or --align-times
 };
 
 TrackerSettings ReadSettings(const ReplayOptions& opt) {
@@ -168,6 +175,41 @@ void PrepareRecording(const ReplayOptions& opt, ReplaySetup* s) {
   s->fps = s->recording->FrameRate();
 }
 
+// The offset between the frames' times and those of the prior file and ground truth (given, or
+// aligning the first stamps), then a check that they overlap (one line, exit 2, when not).
+void AlignTimes(const ReplayOptions& opt, long frames, ReplaySetup* s) {
+  std::vector<double> prior_times;
+  for (const PriorRecord& r : s->priors)
+    prior_times.push_back(r.t);
+  const std::vector<double> truth_times = s->ground_truth->Times();
+  const double first = s->first.timestamp_s;
+  s->time_offset = opt.time_offset;
+  if (opt.align_times && opt.time_offset != 0.0) {
+    throw InputError("replay: give either --time-offset or --align-times, not both");
+  }
+  if (opt.align_times) {
+    const std::vector<double>& times = prior_times.empty() ? truth_times : prior_times;
+    if (times.empty()) throw InputError("--align-times: no prior file or ground-truth times");
+    s->time_offset = *std::min_element(times.begin(), times.end()) - first;
+  }
+  // Frame times from the first to the last frame read (all of them when the count is unknown).
+  const long count =
+      opt.max_frames > 0 && (frames <= 0 || opt.max_frames < frames) ? opt.max_frames : frames;
+  const double last =
+      count > 0 ? first + (count - 1) / s->fps : std::numeric_limits<double>::infinity();
+  auto shifted = [&](std::vector<double> times) {
+    for (double& t : times)
+      t -= s->time_offset;
+    return times;
+  };
+  const double tolerance = 1.0 / s->fps + 0.5;
+  CheckTimesOverlap(
+      shifted(prior_times), first, last, tolerance,
+      s->recording ? opt.input + ": the odometry" : opt.prior_file + ": --prior-file");
+  CheckTimesOverlap(shifted(truth_times), first, last, tolerance,
+                    opt.ground_truth + ": --ground-truth");
+}
+
 ReplaySetup Prepare(const ReplayOptions& opt) {
   ReplaySetup s;
   if (IsRecording(opt.input)) {
@@ -175,6 +217,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
     s.settings = ReadSettings(opt);
     s.ground_truth = std::make_unique<GroundTruth>(opt.ground_truth);
     GrabFirstFrame(opt, &s);
+    AlignTimes(opt, s.frame_count, &s);
     return s;
   }
   if (opt.camera.empty()) throw InputError("replay: --camera is required");
@@ -225,6 +268,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   s.frame_count = s.video->FrameCount();
   GrabFirstFrame(opt, &s);
   s.fps = source_options.frame_rate > 0.0 ? source_options.frame_rate : 30.0;
+  AlignTimes(opt, s.frame_count, &s);
   return s;
 }
 
@@ -232,7 +276,8 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
   if (!s.robot) return std::nullopt;
   RobotReading reading;
   if (!s.priors.empty()) {
-    const std::optional<RobotPose> prior = InterpolatePrior(s.priors, t, 1.0 / s.fps + 0.5);
+    const std::optional<RobotPose> prior =
+        InterpolatePrior(s.priors, t + s.time_offset, 1.0 / s.fps + 0.5);
     if (!prior) return std::nullopt;  // outside the prior file: a free frame
     reading.odometry = prior->Planar();
     reading.height = prior->height;
@@ -290,8 +335,7 @@ class ReplayTracking {
           *localizer_, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
     }
     SequenceTrackerOptions sequence_options;
-    // The output bag's poses carry ViSP's covariance on every frame.
-    sequence_options.covariance_every_frame = !opt.recording.out_bag.empty();
+    sequence_options.integrity = opt.integrity.Options();
     sequence_ = std::make_unique<SequenceTracker>(&tracker_, s.camera, relocalizer_.get(),
                                                   sequence_options);
     if (s.start_pose) sequence_->SetStartPose(*s.start_pose);
@@ -326,7 +370,9 @@ class ReplayTracking {
 struct ReplayRun {
   // Creates the log and the overlay in opt.out, which must exist.
   ReplayRun(const ReplayOptions& opt, const ReplaySetup& s)
-      : out(opt.out), log(opt.out, s.ground_truth->enabled()) {
+      : out(opt.out),
+        log(opt.out, s.ground_truth->enabled(), opt.integrity.all_poses),
+        integrity_options(opt.integrity.Options()) {
     if (!opt.no_overlay) {
       overlay = std::make_unique<OverlayWriter>(opt.out, opt.overlay_png, s.fps,
                                                 cv::Size(s.camera.width, s.camera.height));
@@ -341,6 +387,8 @@ struct ReplayRun {
 
   std::string out;
   ReplayLog log;
+  IntegrityOptions integrity_options;  // the alert limit and allowances of the run
+  IntegrityTally integrity;            // statuses and sigmas; with ground truth the failures
   std::unique_ptr<OverlayWriter> overlay;
   ReplayRunInfo info;
   std::vector<ReplayFrameRecord> records;
@@ -354,13 +402,15 @@ struct ReplayRun {
 void WriteSummary(const SequenceTracker& sequence, ReplayRun* run) {
   run->info.losses = sequence.losses();
   run->info.recoveries = sequence.recoveries();
+  run->info.integrity = run->integrity.Summary(run->integrity_options);
   WriteFileAtomically(run->out + "/summary.json",
                       ReplaySummary(run->records, run->info).dump(2) + "\n");
 }
 
 // What the log and the summary keep of one processed frame; errors against the ground truth
-// when it has the frame.
-ReplayFrameRecord RecordFrame(const Frame& frame, const FrameReport& report, const ReplaySetup& s) {
+// when it has the frame, and the pose's integrity (tallied into *integrity).
+ReplayFrameRecord RecordFrame(const Frame& frame, const FrameReport& report, const ReplaySetup& s,
+                              IntegrityTally* integrity) {
   ReplayFrameRecord record;
   record.frame = static_cast<long>(frame.frame_id);
   record.t = frame.timestamp_s;
@@ -368,13 +418,17 @@ ReplayFrameRecord RecordFrame(const Frame& frame, const FrameReport& report, con
   record.has_pose = report.cam_from_world.has_value();
   record.projection_error_deg = report.health.projection_error_deg;
   record.edges_good = report.health.edges_good;
+  std::optional<IntegrityCheck> check;
   if (report.cam_from_world) {
-    if (const auto truth = s.ground_truth->At(record.frame, record.t, 0.5 / s.fps)) {
+    if (const auto truth =
+            s.ground_truth->At(record.frame, record.t + s.time_offset, 0.5 / s.fps)) {
       const PoseDifference d = ComparePoses(*report.cam_from_world, *truth);
       record.translation_error_m = d.translation;
       record.rotation_error_deg = RadToDeg(d.rotation);
+      check = CheckAgainstTruth(report.uncertainty, *report.cam_from_world, *truth, s.robot);
     }
   }
+  integrity->Add(report.uncertainty, check);
   return record;
 }
 
@@ -385,7 +439,7 @@ void ProcessFrame(const ReplayOptions& opt, const ReplaySetup& s, const Frame& f
   const Clock::time_point step_start = Clock::now();
   const std::optional<RobotReading> reading = ReadingAt(opt, s, frame.timestamp_s);
   const FrameReport report = sequence.Process(frame.image, frame.timestamp_s, reading);
-  ReplayFrameRecord record = RecordFrame(frame, report, s);
+  ReplayFrameRecord record = RecordFrame(frame, report, s, &run->integrity);
   record.step_ms = Milliseconds(Clock::now() - step_start);
   record.decode_ms = run->decode_ms;
   run->with_pose += record.has_pose ? 1 : 0;
@@ -450,8 +504,9 @@ void FinishFiles(const SequenceTracker& sequence, ReplayRun* run) {
 void PrintReplayLine(const SequenceTracker& sequence, const ReplayRun& run) {
   const nlohmann::ordered_json summary = ReplaySummary(run.records, run.info);
   std::cout << "replayed " << run.records.size() << " frames: " << run.with_pose << " with a pose ("
-            << summary["status_counts"].dump() << "), " << sequence.losses() << " losses, "
-            << sequence.recoveries() << " recoveries, "
+            << summary["status_counts"].dump() << "; integrity "
+            << summary["integrity"]["status_counts"].dump() << "), " << sequence.losses()
+            << " losses, " << sequence.recoveries() << " recoveries, "
             << static_cast<int>(summary["throughput_fps"].get<double>())
             << " frames/s without the overlay";
   if (summary.contains("ground_truth")) {
@@ -459,6 +514,10 @@ void PrintReplayLine(const SequenceTracker& sequence, const ReplayRun& run) {
               << summary["ground_truth"]["ate_rmse_m"].get<double>() * 100.0 << " cm, worst "
               << summary["ground_truth"]["translation_m"]["max"].get<double>() * 100.0 << " cm / "
               << summary["ground_truth"]["rotation_deg"]["max"].get<double>() << " deg";
+  }
+  if (summary["integrity"].contains("ground_truth")) {
+    std::cout << "; integrity failures "
+              << summary["integrity"]["ground_truth"]["integrity_failures"].get<int>();
   }
   std::cout << (run.info.complete ? "" : " (interrupted: " + run.info.interruption + ")")
             << std::endl;
@@ -534,10 +593,18 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
       "--fps", opt->fps,
       "Frame rate (default: the video's, else the prior or ground-truth time step, else "
       "30)");
+  cmd->add_option("--time-offset", opt->time_offset,
+                  "Seconds added to the frames' times to read --prior-file and --ground-truth "
+                  "(their time base minus the frames')")
+      ->capture_default_str();
+  cmd->add_flag("--align-times", opt->align_times,
+                "Align the first time of --prior-file (else --ground-truth) on the first frame's");
   cmd->add_option("--frames", opt->max_frames, "Stop after this many frames (0: all)");
   cmd->add_flag("--overlay-png", opt->overlay_png, "Overlay as DIR/overlay/frame_%05d.png");
   cmd->add_flag("--no-overlay", opt->no_overlay, "No overlay");
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
+  AddIntegrityFlags(cmd, &opt->integrity);
+  AddAllPosesFlag(cmd, &opt->integrity);
   RecordingOptions& bag = opt->recording;
   cmd->add_option("--image-topic", bag.image_topic, "Bag: sensor_msgs/Image topic");
   cmd->add_option("--odom-topic", bag.odom_topic, "Bag: nav_msgs/Odometry topic (the prior)");
@@ -569,6 +636,8 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
                  {"--image-topic", "--odom-topic", "--camera-info-topic", "--joint-states-topic",
                   "--pan-joint", "--tilt-joint", "--out-bag"},
                  "applies to a rosbag input (--input RUN.bag)");
+    RefuseUnless(*cmd, !IsRecording(opt->input), {"--time-offset", "--align-times"},
+                 "not with a rosbag input (its odometry has the images' stamps)");
     *action = [opt] { return RunReplay(*opt); };
   });
 }

@@ -237,13 +237,14 @@ void RosBagRecording::Add(double t, const FrameReport& report) {
   pose.header.stamp = stamp;
   pose.header.frame_id = "map";
   pose.pose.pose = ToPoseMsg(map_from_base);
-  if (report.covariance) {
-    pose.pose.covariance = ToCovarianceMsg(
-        RosPoseCovariance(*report.covariance, *report.cam_from_world, BaseFromCamera(mount)));
-  }
-  out_->write("/linetrack/pose", stamp, pose);
+  const std::optional<Matrix6d> covariance =
+      RosCovarianceOf(report.uncertainty, *report.cam_from_world, mount);
+  if (covariance) pose.pose.covariance = ToCovarianceMsg(*covariance);
+  // As the node: tracking poses on the pose topic with map -> odom, the others apart.
+  const bool tracking = covariance && report.uncertainty.status == IntegrityStatus::kTracking;
+  out_->write(tracking ? "/linetrack/pose" : "/linetrack/pose_degraded", stamp, pose);
   const std::optional<Eigen::Isometry3d> odom = OdometryAt(odometry_, t, 0.5);
-  if (!odom) return;
+  if (!tracking || !odom) return;
   tf2_msgs::TFMessage tf;
   geometry_msgs::TransformStamped transform;
   transform.header.stamp = stamp;

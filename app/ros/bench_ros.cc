@@ -133,7 +133,7 @@ int RunBenchRos(const BenchRosOptions& opt) {
   std::cout << "bench ros: " << done.received << " images ("
             << (opt.rate > 0.0 ? std::to_string(opt.rate) + " /s" : std::string("paced")) << "), "
             << done.dropped << " dropped, " << done.processed << " tracked, " << done.with_pose
-            << " poses\n";
+            << " poses on ~pose, " << done.degraded << " on ~pose_degraded\n";
   PrintQuantiles("tracking step", done.track_ms);
   PrintQuantiles("taken to pose published, beyond the tracking step", done.overhead_ms);
   PrintQuantiles("waiting for the worker after arrival", done.wait_ms);

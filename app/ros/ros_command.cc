@@ -17,7 +17,6 @@ namespace {
 
 struct RosCommandOptions {
   RosNodeOptions node;
-  std::string alert_limit;
   std::vector<std::string> ros_args;  // name:=value
   std::vector<std::string> given;     // the flags given, as parameter names
 };
@@ -30,11 +29,6 @@ int RunRos(RosCommandOptions opt) {
       throw InputError("ros: unexpected argument '" + arg + "' (ROS remappings are name:=value)");
     }
     remappings[arg.substr(0, at)] = arg.substr(at + 2);
-  }
-  if (!opt.alert_limit.empty()) {
-    const std::vector<double> limits = ParseNumbers(opt.alert_limit, 2, "--alert-limit");
-    opt.node.alert_position_m = limits[0];
-    opt.node.alert_yaw_deg = limits[1];
   }
   ros::init(remappings, "linetrack", ros::init_options::NoSigintHandler);
   if (!ros::master::check()) {
@@ -58,7 +52,8 @@ int RunRos(RosCommandOptions opt) {
   watcher.join();
   const RosNodeStats stats = node.Stats();
   std::cout << "ros: " << stats.received << " images, " << stats.dropped << " dropped, "
-            << stats.processed << " tracked, " << stats.with_pose << " poses published";
+            << stats.processed << " tracked, " << stats.with_pose << " poses on ~pose, "
+            << stats.degraded << " on ~pose_degraded";
   if (!stats.overhead_ms.empty()) {
     std::cout << "; beyond the tracking step median " << QuantileNearestRank(stats.overhead_ms, 0.5)
               << " ms, p95 " << QuantileNearestRank(stats.overhead_ms, 0.95)
@@ -98,9 +93,16 @@ void AddRos(CLI::App& cli, CommandAction* action) {
        "degrees (~tilt)");
   flag("--pan-joint", "pan_joint", &o.pan_joint, "Pan joint in joint_states (~pan_joint)");
   flag("--tilt-joint", "tilt_joint", &o.tilt_joint, "Tilt joint in joint_states (~tilt_joint)");
-  flag("--alert-limit", "alert_limit", &opt->alert_limit,
-       "POSITION_M,YAW_DEG: a pose with a larger standard deviation is degraded (~alert_limit, "
-       "default 0.10,2)");
+  flag("--alert-limit", "alert_limit", &o.integrity.alert_limit,
+       "METRES,DEGREES: a pose is 'tracking' (on ~pose) only when its protection levels are "
+       "within it, else 'degraded' (~pose_degraded) (~alert_limit, default 0.10,2)");
+  flag("--camera-sigma", "camera_sigma", &o.integrity.camera_sigma,
+       "Calibration uncertainty FOCAL_RELATIVE,PRINCIPAL_POINT_PX in the covariance "
+       "(~camera_sigma, default 0.003,1)");
+  flag("--model-sigma", "model_sigma", &o.integrity.model_sigma_m,
+       "Model error allowance, metres at each edge end (~model_sigma)");
+  flag("--odom-wait", "odom_wait", &o.odom_wait,
+       "Seconds an image waits for the odometry to reach its stamp (~odom_wait, default 0.05)");
   flag("--transform-tolerance", "transform_tolerance", &o.transform_tolerance,
        "Seconds added to the stamp of map -> odom, as AMCL (~transform_tolerance, default 0.1)");
   // Remappings are positional, so that unknown flags still reach the global ones (-q).

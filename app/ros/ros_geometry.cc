@@ -5,18 +5,9 @@
 #include <cmath>
 
 #include "models/geometry.h"
+#include "tracking/integrity/ros_covariance.h"
 
 namespace linetrack::app {
-namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d s;
-  s << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return s;
-}
-
-}  // namespace
-
 bool CameraMount::Check(std::string* why) const {
   if (!std::isfinite(height) || !std::isfinite(pan) || !std::isfinite(tilt)) {
     *why = "camera mount: height, pan and tilt must be finite";
@@ -63,33 +54,14 @@ Eigen::Isometry3d MapFromOdom(const Eigen::Isometry3d& map_from_base,
   return map_from_base * odom_from_base.inverse();
 }
 
-Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& r) {
-  const double a = r.norm();
-  const Eigen::Matrix3d k = Skew(r);
-  if (a < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * k + k * k / 6.0;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(a)) / (a * a) * k +
-         (a - std::sin(a)) / (a * a * a) * k * k;
-}
-
-Matrix6d RosPoseJacobian(const Eigen::Isometry3d& cam_from_map,
-                         const Eigen::Isometry3d& base_from_cam) {
-  const Eigen::Matrix3d r = cam_from_map.linear();
-  const Eigen::Vector3d t = cam_from_map.translation();
-  const Eigen::Vector3d t_cb = base_from_cam.inverse().translation();
-  const Eigen::Matrix3d j =
-      LeftJacobianSO3(Eigen::AngleAxisd(r).angle() * Eigen::AngleAxisd(r).axis());
-  Matrix6d m = Matrix6d::Zero();
-  m.topLeftCorner<3, 3>() = -r.transpose();
-  m.topRightCorner<3, 3>() = -r.transpose() * Skew(t - t_cb) * j;
-  m.bottomRightCorner<3, 3>() = -r.transpose() * j;
-  return m;
-}
-
-Matrix6d RosPoseCovariance(const Matrix6d& visp_covariance, const Eigen::Isometry3d& cam_from_map,
-                           const Eigen::Isometry3d& base_from_cam) {
-  const Matrix6d m = RosPoseJacobian(cam_from_map, base_from_cam);
-  const Matrix6d c = m * visp_covariance * m.transpose();
-  return 0.5 * (c + c.transpose());
+std::optional<Matrix6d> RosCovarianceOf(const PoseUncertainty& uncertainty,
+                                        const Eigen::Isometry3d& cam_from_map,
+                                        const CameraMount& mount) {
+  if (!uncertainty.has_covariance()) return std::nullopt;
+  const Matrix6d c =
+      RosBaseCovariance(uncertainty.world_covariance, cam_from_map, BaseFromCamera(mount));
+  if (!c.allFinite()) return std::nullopt;
+  return Matrix6d(0.5 * (c + c.transpose()));
 }
 
 std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& readings, double t,

@@ -11,6 +11,7 @@
 
 #include "matching/localizer.h"
 #include "models/robot_pose.h"
+#include "tracking/integrity/integrity_monitor.h"
 #include "tracking/tracker/relocalizer.h"
 
 namespace linetrack::app {
@@ -51,23 +52,12 @@ Eigen::Isometry3d MapFromBase(const Eigen::Isometry3d& cam_from_map, const Camer
 Eigen::Isometry3d MapFromOdom(const Eigen::Isometry3d& map_from_base,
                               const Eigen::Isometry3d& odom_from_base);
 
-// ROS's pose covariance (geometry_msgs/PoseWithCovariance: x, y, z and rotations about the fixed
-// X, Y, Z axes of the parent frame, 6 x 6) of the base in the map, from ViSP's covariance of the
-// camera pose parameters p = (t, theta u) of cMo (vpMbTracker::getCovarianceMatrix). With
-// cMo = (R, t) perturbed as t + dt, R' = exp([J dthetau]x) R (J the left Jacobian of SO(3) at
-// theta u), the base's origin B moves by dB = -R^T dt - R^T [t - t_cb]x J dthetau and the base
-// turns by w = -R^T J dthetau about the map's axes (t_cb: base origin in the camera frame);
-// the result is M Sigma M^T with M that 6 x 6 Jacobian. docs/ros.md derives it.
-Matrix6d RosPoseCovariance(const Matrix6d& visp_covariance, const Eigen::Isometry3d& cam_from_map,
-                           const Eigen::Isometry3d& base_from_cam);
-
-// The Jacobian M of RosPoseCovariance: (dB, w) = M (dt, dthetau).
-Matrix6d RosPoseJacobian(const Eigen::Isometry3d& cam_from_map,
-                         const Eigen::Isometry3d& base_from_cam);
-
-// Left Jacobian of SO(3) at the rotation vector r: exp([r + dr]x) = exp([J dr]x) exp([r]x) to
-// first order; J = I + (1 - cos a)/a^2 [r]x + (a - sin a)/a^3 [r]x^2, a = |r|.
-Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& r);
+// ROS's pose covariance (geometry_msgs/PoseWithCovariance: x, y, z, roll, pitch, yaw of the base
+// in the map, RosBaseCovariance) of a tracked pose's uncertainty (the integrity monitor's world
+// twist covariance, PoseUncertainty), the camera at cam_from_map on `mount`; nullopt without one.
+std::optional<Matrix6d> RosCovarianceOf(const PoseUncertainty& uncertainty,
+                                        const Eigen::Isometry3d& cam_from_map,
+                                        const CameraMount& mount);
 
 // A stamped pose of the base in the odometry frame (nav_msgs/Odometry).
 struct StampedOdometry {

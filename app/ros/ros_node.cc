@@ -61,10 +61,10 @@ void RosNodeOptions::Check() const {
     }
     CheckRange(tilt_deg, -89.0, 89.0, "--tilt");
   }
-  CheckRange(alert_position_m, 1e-6, 100.0, "--alert-limit (position)");
-  CheckRange(alert_yaw_deg, 1e-6, 180.0, "--alert-limit (yaw)");
+  integrity.Options();  // throws naming the flag
   CheckRange(transform_tolerance, 0.0, 10.0, "--transform-tolerance");
   CheckRange(odom_max_gap, 0.0, 10.0, "--odom-max-gap");
+  CheckRange(odom_wait, 0.0, 1.0, "--odom-wait");
   for (const std::string* frame : {&map_frame, &odom_frame, &base_frame}) {
     if (frame->empty()) throw InputError("ros: frame names must not be empty");
   }
@@ -84,12 +84,10 @@ void ReadRosParameters(const ros::NodeHandle& nh, const std::vector<std::string>
   Param(nh, given, "tilt_joint", &o->tilt_joint);
   Param(nh, given, "transform_tolerance", &o->transform_tolerance);
   Param(nh, given, "odom_max_gap", &o->odom_max_gap);
-  std::string alert;
-  if (!Given(given, "alert_limit") && nh.getParam("alert_limit", alert)) {
-    const std::vector<double> limits = ParseNumbers(alert, 2, "~alert_limit");
-    o->alert_position_m = limits[0];
-    o->alert_yaw_deg = limits[1];
-  }
+  Param(nh, given, "odom_wait", &o->odom_wait);
+  Param(nh, given, "alert_limit", &o->integrity.alert_limit);
+  Param(nh, given, "camera_sigma", &o->integrity.camera_sigma);
+  Param(nh, given, "model_sigma", &o->integrity.model_sigma_m);
 }
 
 struct RosNode::Impl {
@@ -109,7 +107,7 @@ struct RosNode::Impl {
   image_transport::Subscriber image_sub;
   image_transport::Publisher overlay_pub;
   ros::Subscriber info_sub, odom_sub, joints_sub, initial_sub;
-  ros::Publisher pose_pub, status_pub;
+  ros::Publisher pose_pub, degraded_pub, status_pub;
   ros::ServiceServer global_srv;
   tf2_ros::TransformBroadcaster tf;
   diagnostic_updater::Updater updater;
@@ -117,6 +115,8 @@ struct RosNode::Impl {
   RosTrackerOptions tracker_options;
   std::unique_ptr<RosTracker> tracker;  // worker thread only
   std::unique_ptr<OcclusionTester> occlusion;
+  // From the last tracking pose (worker thread only); cleared by a new initial pose.
+  std::optional<Eigen::Isometry3d> map_from_odom;
 
   mutable std::mutex mutex;  // guards everything below
   std::condition_variable wake;
@@ -157,8 +157,7 @@ void RosNode::Impl::Setup() {
   tracker_options.model_path = options.model;
   tracker_options.settings =
       options.settings.empty() ? base : ReadTrackerSettings(options.settings, base);
-  tracker_options.alert_position_m = options.alert_position_m;
-  tracker_options.alert_yaw_rad = DegToRad(options.alert_yaw_deg);
+  tracker_options.sequence.integrity = options.integrity.Options();
   if (!options.camera.empty()) {
     tracker_options.camera = LoadCamera(options.camera);
     if (tracker_options.camera.width <= 0) {
@@ -173,6 +172,7 @@ void RosNode::Impl::Setup() {
   joints_sub = nh.subscribe("joint_states", 100, &Impl::OnJoints, this);
   initial_sub = nh.subscribe("initialpose", 2, &Impl::OnInitialPose, this);
   pose_pub = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 10);
+  degraded_pub = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose_degraded", 10);
   status_pub = pnh.advertise<std_msgs::String>("status", 10, /*latch=*/true);
   overlay_pub = private_it.advertise("overlay", 1);
   global_srv = pnh.advertiseService("global_localization", &Impl::OnGlobalLocalization, this);
@@ -205,6 +205,7 @@ void RosNode::Impl::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
   odometry.push_back(reading);
   while (!odometry.empty() && odometry.back().t - odometry.front().t > 10.0)
     odometry.pop_front();
+  wake.notify_one();  // an image may be waiting for this reading
 }
 
 void RosNode::Impl::OnJoints(const sensor_msgs::JointStateConstPtr& msg) {
@@ -250,6 +251,7 @@ void RosNode::Impl::Diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("images dropped", stats.dropped);
   status.add("images processed", stats.processed);
   status.add("poses published", stats.with_pose);
+  status.add("degraded poses published", stats.degraded);
   if (!stats.track_ms.empty()) {
     status.add("tracking step median (ms)", QuantileNearestRank(stats.track_ms, 0.5));
     status.add("latency beyond tracking median (ms)", QuantileNearestRank(stats.overhead_ms, 0.5));
@@ -291,6 +293,7 @@ void RosNode::Impl::ApplyStart() {
   }
   const SearchBounds bounds =
       BoundsFromCovariance(s->covariance, RelocalizationOptions(), options.initial_bounds_scale);
+  map_from_odom.reset();
   tracker->Restart(s->map_base, odom ? std::optional<Pose3Dof>(PlanarOf(*odom)) : std::nullopt,
                    bounds);
   ROS_INFO("linetrack: initial pose (%.2f, %.2f, %.1f deg), matcher bounds %.2f m, %.1f deg",
@@ -319,7 +322,9 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
   input.t = header.stamp.toSec();
   std::optional<Eigen::Isometry3d> odom;
   {
-    std::lock_guard<std::mutex> lock(mutex);
+    std::unique_lock<std::mutex> lock(mutex);
+    wake.wait_for(lock, std::chrono::duration<double>(options.odom_wait),
+                  [&] { return stop || odometry.empty() || odometry.back().t >= input.t; });
     input.mount = MountNow();
     const std::vector<StampedOdometry> readings(odometry.begin(), odometry.end());
     odom = OdometryAt(readings, input.t, options.odom_max_gap);
@@ -332,7 +337,8 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
   {
     std::lock_guard<std::mutex> lock(mutex);
     ++stats.processed;
-    if (out.map_from_base) ++stats.with_pose;
+    if (out.map_from_base)
+      ++(out.status == RosStatus::kTracking ? stats.with_pose : stats.degraded);
     stats.track_ms.push_back(out.track_ms);
     stats.overhead_ms.push_back(busy_ms - out.track_ms);
     stats.wait_ms.push_back(wait_ms);
@@ -349,6 +355,9 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
   ++frame_index;
 }
 
+// Tracking poses go on ~pose and set map -> odom; the others (degraded, or a matcher's pose being
+// confirmed) on ~pose_degraded only, so that a consumer fusing ~pose never takes one blindly.
+// map -> odom, from the last tracking pose, is sent with every frame's stamp.
 void RosNode::Impl::Publish(const TrackedFrame& out, const std_msgs::Header& header,
                             const std::optional<Eigen::Isometry3d>& odom_from_base) {
   if (out.map_from_base) {
@@ -357,15 +366,20 @@ void RosNode::Impl::Publish(const TrackedFrame& out, const std_msgs::Header& hea
     pose.header.frame_id = options.map_frame;
     pose.pose.pose = ToPoseMsg(*out.map_from_base);
     if (out.covariance) pose.pose.covariance = ToCovarianceMsg(*out.covariance);
-    pose_pub.publish(pose);
-    if (odom_from_base) {
-      geometry_msgs::TransformStamped transform;
-      transform.header.stamp = header.stamp + ros::Duration(options.transform_tolerance);
-      transform.header.frame_id = options.map_frame;
-      transform.child_frame_id = options.odom_frame;
-      transform.transform = ToTransformMsg(MapFromOdom(*out.map_from_base, *odom_from_base));
-      tf.sendTransform(transform);
+    const bool tracking = out.status == RosStatus::kTracking;
+    (tracking ? pose_pub : degraded_pub).publish(pose);
+    if (tracking && odom_from_base) {
+      map_from_odom = MapFromOdom(*out.map_from_base, *odom_from_base);
     }
+  }
+  // As AMCL: the last correction is sent on every frame, so that map -> odom stays current.
+  if (map_from_odom) {
+    geometry_msgs::TransformStamped transform;
+    transform.header.stamp = header.stamp + ros::Duration(options.transform_tolerance);
+    transform.header.frame_id = options.map_frame;
+    transform.child_frame_id = options.odom_frame;
+    transform.transform = ToTransformMsg(*map_from_odom);
+    tf.sendTransform(transform);
   }
   std_msgs::String status;
   status.data = ToString(out.status);

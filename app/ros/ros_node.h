@@ -1,7 +1,8 @@
 // `linetrack ros`: the ROS 1 node, with the conventions of ROS's laser localiser AMCL. Subscribes
 // (relative names, remappable) image (image_transport), camera_info (without --camera), odom,
 // joint_states (pan and tilt joints) and initialpose; publishes ~pose (PoseWithCovarianceStamped
-// of the base in the map, stamped with the image's stamp), map -> odom on /tf (never map -> base),
+// of the base in the map, stamped with the image's stamp; tracking poses only) and map -> odom on
+// /tf from them (never map -> base), ~pose_degraded (the other poses, with their covariance),
 // ~status, diagnostics and ~overlay; serves ~global_localization. Images arriving while one is
 // tracked replace the waiting one (the oldest is dropped and counted): it never lags the stream.
 #pragma once
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/integrity_output.h"
 #include "app/ros/ros_geometry.h"
 
 namespace linetrack::app {
@@ -28,10 +30,13 @@ struct RosNodeOptions {
   double height = std::numeric_limits<double>::quiet_NaN();    // camera above the base (m)
   double tilt_deg = std::numeric_limits<double>::quiet_NaN();  // without a tilt joint
   std::string pan_joint, tilt_joint;  // joint_states names; empty: no such joint
-  double alert_position_m = 0.10;     // ~alert_limit: position (m) and yaw (deg)
-  double alert_yaw_deg = 2.0;
-  double transform_tolerance = 0.1;   // s added to map -> odom's stamp, as AMCL does
-  double odom_max_gap = 0.5;          // s: odometry this far from an image's stamp is not used
+  // ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma: the integrity monitor's
+  IntegrityFlags integrity;
+  double transform_tolerance = 0.1;  // s added to map -> odom's stamp, as AMCL does
+  double odom_max_gap = 0.5;         // s: odometry this far from an image's stamp is not used
+  // s: how long an image waits for the odometry to reach its stamp (odometry and images come on
+  // separate connections; a reading from before the image would lag the pose by its motion).
+  double odom_wait = 0.05;
   double initial_bounds_scale = 1.5;  // matcher bounds = this many standard deviations
 
   // Throws InputError naming the parameter when a value is out of range.
@@ -40,7 +45,8 @@ struct RosNodeOptions {
 
 // Fills the options not given on the command line from the private parameters (~model,
 // ~camera, ~settings, ~map_frame, ~odom_frame, ~base_frame, ~height, ~tilt, ~pan_joint,
-// ~tilt_joint, ~alert_limit "POSITION_M,YAW_DEG", ~transform_tolerance). `given` names the
+// ~tilt_joint, ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma,
+// ~transform_tolerance, ~odom_max_gap, ~odom_wait). `given` names the
 // command-line flags given (without dashes, e.g. "model").
 void ReadRosParameters(const ros::NodeHandle& private_nh, const std::vector<std::string>& given,
                        RosNodeOptions* options);
@@ -50,7 +56,8 @@ struct RosNodeStats {
   long received = 0;  // images that reached the callback
   long dropped = 0;   // replaced while waiting (the oldest first)
   long processed = 0;
-  long with_pose = 0;
+  long with_pose = 0;  // on ~pose (tracking)
+  long degraded = 0;   // on ~pose_degraded
   // The last frames' (at most 100000): the tracking step; the time from the worker taking the
   // image to its pose published, minus the tracking step (conversion, odometry, publishing); the
   // time the image waited for the worker after its arrival (the frame before it being tracked).

@@ -1,12 +1,10 @@
 #include "app/ros/ros_tracker.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "models/errors.h"
-#include "tracking/tracker/tracking_health.h"
 
 namespace linetrack::app {
 namespace {
@@ -14,6 +12,12 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 }  // namespace
+
+RosStatus StatusOf(IntegrityStatus integrity, bool reacquiring) {
+  if (integrity == IntegrityStatus::kTracking) return RosStatus::kTracking;
+  if (integrity == IntegrityStatus::kLost) return RosStatus::kLost;
+  return reacquiring ? RosStatus::kRelocalising : RosStatus::kDegraded;
+}
 
 const char* ToString(RosStatus status) {
   switch (status) {
@@ -38,10 +42,6 @@ bool RosTrackerOptions::Check(std::string* why) const {
     *why = "the camera's image size is unknown";
     return false;
   }
-  if (!(alert_position_m > 0.0) || !(alert_yaw_rad > 0.0)) {
-    *why = "alert limits must be positive";
-    return false;
-  }
   return relocalization.Check(why) && sequence.Check(why);
 }
 
@@ -52,7 +52,6 @@ RosTracker::RosTracker(const RosTrackerOptions& options)
       undistorted_camera_(options.camera.Undistorted()) {
   std::string why;
   if (!options_.Check(&why)) throw InputError("ros: " + why);
-  options_.sequence.covariance_every_frame = true;
   LocalizerOptions matcher;
   matcher.noise = DetectedLineNoise();  // lines from LineExtractor
   localizer_ = std::make_unique<Localizer>(*loaded_.model, loaded_.regions.get(),
@@ -100,24 +99,10 @@ TrackedFrame RosTracker::Process(const vpImage<unsigned char>& image, const Trac
     had_pose_ = true;
     out.cam_from_map = report.cam_from_world;
     out.map_from_base = MapFromBase(*report.cam_from_world, input.mount);
-    if (report.covariance && report.covariance->allFinite()) {
-      out.covariance = RosPoseCovariance(*report.covariance, *report.cam_from_world,
-                                         BaseFromCamera(input.mount));
-    }
-    out.status = RosStatus::kTracking;
-    if (!out.covariance) {
-      out.status = RosStatus::kDegraded;
-      out.note = "no covariance for this pose";
-    } else {
-      const Eigen::Matrix2d xy = out.covariance->topLeftCorner<2, 2>();
-      const double position_sigma = std::sqrt(std::max(
-          0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(xy).eigenvalues().maxCoeff()));
-      const double yaw_sigma = std::sqrt(std::max(0.0, (*out.covariance)(5, 5)));
-      if (position_sigma > options_.alert_position_m || yaw_sigma > options_.alert_yaw_rad) {
-        out.status = RosStatus::kDegraded;
-        out.note = "the covariance exceeds the alert limits";
-      }
-    }
+    out.covariance = RosCovarianceOf(report.uncertainty, *report.cam_from_world, input.mount);
+    out.status = out.covariance ? StatusOf(report.uncertainty.status, sequence_->reacquiring())
+                                : RosStatus::kDegraded;
+    if (out.status != RosStatus::kTracking) out.note = report.uncertainty.reason;
   } else {
     out.status = had_pose_ && report.status == TrackStatus::kLost ? RosStatus::kLost
                                                                   : RosStatus::kRelocalising;

@@ -1,8 +1,8 @@
 // The one seam between the ROS node and linetrack's tracking: a frame with its stamp, the base's
 // odometry moved into the map and the camera's mount go in; the status, the base's pose in the map
 // and its covariance in ROS's convention come out. Built the way `replay` and `live` build their
-// tracker (matcher, relocaliser, moving edges, SequenceTracker), with ViSP's pose covariance on
-// every frame. No ROS types: the node converts messages on its side.
+// tracker (matcher, relocaliser, moving edges, SequenceTracker with its integrity monitor); the
+// covariance is the integrity monitor's. No ROS types: the node converts messages on its side.
 #pragma once
 
 #include <visp3/core/vpImage.h>
@@ -29,20 +29,22 @@ struct RosTrackerOptions {
   TrackerSettings settings;     // moving edges, visibility, passes
   LineExtractionOptions lines;  // line extraction of the relocaliser
   RelocalizationOptions relocalization;
+  // With the integrity monitor's alert limits and noise (sequence.integrity): a pose whose
+  // protection levels exceed them is degraded.
   SequenceTrackerOptions sequence;
-  // Alert limits: a pose whose covariance has a larger position (metres, largest horizontal
-  // axis) or yaw (radians) standard deviation is reported degraded.
-  double alert_position_m = 0.10;
-  double alert_yaw_rad = 0.0349;
 
   bool Check(std::string* why) const;
 };
 
-// The node's status vocabulary (~status): a pose within the alert limits (tracking), a pose
-// beyond them or without a covariance (degraded), no pose since a loss (lost), no pose yet or
-// since a restart from an initial pose, the matcher searching (relocalising).
+// The node's status vocabulary (~status): the integrity monitor's tracking and degraded for a
+// pose, lost for none since a loss; relocalising while the matcher searches (no pose yet, or since
+// an initial pose) and while its pose is being confirmed (ReacquisitionCheck).
 enum class RosStatus { kTracking, kDegraded, kLost, kRelocalising };
 const char* ToString(RosStatus status);
+
+// The status of a frame with a pose: the integrity monitor's, relocalising for a degraded pose
+// while the matcher's pose is being confirmed.
+RosStatus StatusOf(IntegrityStatus integrity, bool reacquiring);
 
 // What the node knows at an image's stamp.
 struct TrackerInput {
@@ -59,7 +61,7 @@ struct TrackedFrame {
   std::string note;    // why there is no pose, or why it is degraded
   std::optional<Eigen::Isometry3d> cam_from_map;
   std::optional<Eigen::Isometry3d> map_from_base;
-  std::optional<Matrix6d> covariance;  // ROS convention (RosPoseCovariance), with the pose
+  std::optional<Matrix6d> covariance;  // ROS convention (RosCovarianceOf), with the pose
   double track_ms = 0.0;               // the tracking step (undistortion to judged pose)
   FrameReport report;                  // the engine's own report (overlay, health)
 };

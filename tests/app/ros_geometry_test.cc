@@ -1,9 +1,11 @@
 // The maths of app/ros/ros_geometry.h on exact synthetic poses: the camera mount, AMCL's
-// map -> odom correction, the pose covariance's Jacobian against finite differences, odometry
+// map -> odom correction, the pose covariance in ROS's convention, odometry
 // interpolation and the matcher's bounds from RViz's initial pose covariance.
 #include "app/ros/ros_geometry.h"
 
 #include <gtest/gtest.h>
+
+#include <array>
 
 #include "models/geometry.h"
 
@@ -11,19 +13,6 @@ namespace linetrack::app {
 namespace {
 
 constexpr double kExact = 1e-9;
-constexpr double kFiniteDifferenceStep = 1e-6;
-constexpr double kFiniteDifferenceTol = 1e-5;  // first-order Jacobian vs central differences
-
-Eigen::Vector3d RotationVector(const Eigen::Matrix3d& r) {
-  const Eigen::AngleAxisd aa(r);
-  return aa.angle() * aa.axis();
-}
-
-Eigen::Matrix3d Exp(const Eigen::Vector3d& r) {
-  const double a = r.norm();
-  if (a == 0.0) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(a, r / a).toRotationMatrix();
-}
 
 // A camera 1.3 m above a base at (2, 3) heading 40 degrees, panned 25 and tilted 10 degrees.
 struct Scene {
@@ -49,53 +38,30 @@ TEST(RosGeometry, MapFromOdomComposesBackToTheTrackedBase) {
   EXPECT_TRUE((map_from_odom * odom_from_base).isApprox(s.map_from_base, kExact));
 }
 
-TEST(RosGeometry, LeftJacobianMatchesFiniteDifferences) {
-  const Eigen::Vector3d r(0.3, -0.8, 1.1);
-  const Eigen::Matrix3d j = LeftJacobianSO3(r);
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d dr = kFiniteDifferenceStep * Eigen::Vector3d::Unit(k);
-    const Eigen::Vector3d plus = RotationVector(Exp(r + dr) * Exp(r).transpose());
-    const Eigen::Vector3d minus = RotationVector(Exp(r - dr) * Exp(r).transpose());
-    const Eigen::Vector3d numeric = (plus - minus) / (2.0 * kFiniteDifferenceStep);
-    EXPECT_LT((numeric - j.col(k)).norm(), kFiniteDifferenceTol) << "column " << k;
-  }
-}
-
-// The base's pose for the parameters p = (t, theta u) of cMo: (B, R_wb).
-Eigen::Isometry3d BaseOfParameters(const Eigen::Matrix<double, 6, 1>& p,
-                                   const Eigen::Isometry3d& base_from_cam) {
-  Eigen::Isometry3d cam_from_map = Eigen::Isometry3d::Identity();
-  cam_from_map.translation() = p.head<3>();
-  cam_from_map.linear() = Exp(p.tail<3>());
-  return cam_from_map.inverse() * base_from_cam.inverse();
-}
-
-TEST(RosGeometry, PoseCovarianceJacobianMatchesFiniteDifferences) {
+// The base's origin is below the optical centre and turns with the camera about z: a twist
+// covariance in the camera centre's x, y and the heading (omega_z) alone is the base's x, y, yaw
+// covariance; without a covariance there is none.
+TEST(RosGeometry, PlanarTwistCovarianceIsTheBasesXYYaw) {
   const Scene s;
-  const Eigen::Isometry3d base_from_cam = BaseFromCamera(s.mount);
-  Eigen::Matrix<double, 6, 1> p;
-  p << s.cam_from_map.translation(), RotationVector(s.cam_from_map.linear());
-  const Matrix6d m = RosPoseJacobian(s.cam_from_map, base_from_cam);
-  const Eigen::Isometry3d base = BaseOfParameters(p, base_from_cam);
-  for (int k = 0; k < 6; ++k) {
-    const Eigen::Matrix<double, 6, 1> dp =
-        kFiniteDifferenceStep * Eigen::Matrix<double, 6, 1>::Unit(k);
-    const Eigen::Isometry3d plus = BaseOfParameters(p + dp, base_from_cam);
-    const Eigen::Isometry3d minus = BaseOfParameters(p - dp, base_from_cam);
-    Eigen::Matrix<double, 6, 1> numeric;
-    numeric.head<3>() = (plus.translation() - minus.translation()) / (2 * kFiniteDifferenceStep);
-    // Rotation about the map's fixed axes: R' = exp([w]x) R.
-    numeric.tail<3>() = (RotationVector(plus.linear() * base.linear().transpose()) -
-                         RotationVector(minus.linear() * base.linear().transpose())) /
-                        (2 * kFiniteDifferenceStep);
-    EXPECT_LT((numeric - m.col(k)).norm(), kFiniteDifferenceTol) << "parameter " << k;
+  Matrix6d twist = Matrix6d::Zero();
+  twist(0, 0) = 4e-4;
+  twist(1, 1) = 1e-4;
+  twist(0, 1) = twist(1, 0) = -5e-5;
+  twist(5, 5) = 3e-5;
+  twist(0, 5) = twist(5, 0) = 2e-5;
+  PoseUncertainty u;
+  u.world_covariance = twist;
+  const std::optional<Matrix6d> ros = RosCovarianceOf(u, s.cam_from_map, s.mount);
+  ASSERT_TRUE(ros.has_value());
+  const std::array<int, 3> planar = {0, 1, 5};
+  for (int i : planar) {
+    for (int j : planar) {
+      EXPECT_NEAR((*ros)(i, j), twist(i, j), kExact) << i << "," << j;
+    }
   }
-  // The covariance is M Sigma M^T, symmetric.
-  Matrix6d sigma = Matrix6d::Identity() * 1e-4;
-  sigma(0, 3) = sigma(3, 0) = 2e-5;
-  const Matrix6d ros = RosPoseCovariance(sigma, s.cam_from_map, base_from_cam);
-  EXPECT_TRUE(ros.isApprox(m * sigma * m.transpose(), kExact));
-  EXPECT_TRUE(ros.isApprox(ros.transpose(), kExact));
+  const Eigen::Matrix3d z_roll_pitch = ros->block<3, 3>(2, 2);
+  EXPECT_NEAR(z_roll_pitch.norm(), 0.0, kExact);  // z, roll, pitch: known
+  EXPECT_FALSE(RosCovarianceOf(PoseUncertainty(), s.cam_from_map, s.mount).has_value());
 }
 
 TEST(RosGeometry, OdometryIsInterpolatedAtTheImageStamp) {

@@ -5,6 +5,8 @@
 
 #include <sensor_msgs/Image.h>
 
+#include <Eigen/Core>
+
 #include <string>
 #include <vector>
 
@@ -45,6 +47,16 @@ inline RenderedDrive RenderHallDrive(int count, double pan_amplitude) {
   for (int i = 0; i < count; ++i)
     r.images.push_back(renderer.Render(r.frames[i].cam_from_world, i));
   return r;
+}
+
+// The x, y, yaw block (rows and columns 0, 1, 5) of a ROS pose covariance.
+inline Eigen::Matrix3d PlanarBlock(const Eigen::Matrix<double, 6, 6>& c) {
+  const int k[3] = {0, 1, 5};
+  Eigen::Matrix3d b;
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 3; ++j)
+      b(r, j) = c(k[r], k[j]);
+  return b;
 }
 
 inline sensor_msgs::Image ImageMsg(const vpImage<unsigned char>& image, const ros::Time& stamp) {

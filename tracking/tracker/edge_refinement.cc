@@ -33,11 +33,9 @@ bool Bilinear(const vpImage<unsigned char>& image, const Eigen::Vector2d& p, dou
   return true;
 }
 
-// A model edge as seen from the start pose: its 3D part inside the view and its image.
-struct ViewedEdge {
-  Eigen::Vector3d a, b;                 // world, clipped to the frustum
-  std::vector<Eigen::Vector2d> points;  // sub-pixel edge points attached to it
-};
+// A model edge as seen from the start pose (its 3D part inside the view, clipped to the frustum)
+// and the sub-pixel edge points attached to it.
+using ViewedEdge = EdgeObservation;
 
 // Left-multiplied update: exp([omega, v]) * pose, in the camera frame.
 Eigen::Isometry3d Update(const Eigen::Isometry3d& pose, const Eigen::Matrix<double, 6, 1>& delta) {
@@ -200,6 +198,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
 
   const Eigen::VectorXd& p = solve.p;
   const Eigen::MatrixXd& information = solve.information;
+  std::vector<ViewedEdge> set_aside;
   for (int rejections = 0;; ++rejections) {
     const int n = PointCount(used);
     if (n < options.min_points) return out;
@@ -218,6 +217,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
     if (worst < 0) break;
     out.rejected_points += static_cast<int>(used[worst].points.size());
     ++out.rejected_edges;
+    set_aside.push_back(std::move(used[worst]));
     used.erase(used.begin() + worst);
   }
   const Eigen::Isometry3d pose = parameters.Pose(p);
@@ -238,6 +238,8 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   out.applied = true;
   out.cam_from_world = pose;
   out.points = PointCount(used);
+  out.observations = std::move(used);
+  out.set_aside = std::move(set_aside);
   // Standard deviations from the Gauss-Newton information and the residuals' scale.
   const double scale2 = r.squaredNorm() / std::max(1, static_cast<int>(r.size()) - dof);
   const Eigen::MatrixXd covariance = scale2 * information.inverse();
@@ -338,12 +340,12 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
   // The model edges in view and their images at the start pose.
   std::vector<ViewedEdge> viewed;
   std::vector<Segment2> images;
-  for (const Segment3& edge : edges) {
-    Segment3 clipped = edge;
+  for (size_t index = 0; index < edges.size(); ++index) {
+    Segment3 clipped = edges[index];
     if (!ClipToFrustum(start, camera, kNearClip, &clipped)) continue;
     const Segment2 image_edge{camera.Project(start * clipped.a), camera.Project(start * clipped.b)};
     if (image_edge.Length() < 2.0 * options.end_margin_px + 2.0) continue;
-    viewed.push_back(ViewedEdge{clipped.a, clipped.b, {}});
+    viewed.push_back(ViewedEdge{clipped.a, clipped.b, {}, static_cast<int>(index)});
     images.push_back(image_edge);
   }
   // Each site goes to the one projected edge it lies on, then to the sub-pixel step near it.
@@ -389,8 +391,8 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
     solve.search_px = round == 0 ? options.search_px : options.solve.search_px;
     solve.max_correction_px = solve.search_px;
     std::vector<ViewedEdge> viewed;
-    for (const Segment3& part : visible) {
-      Segment3 clipped = part;
+    for (size_t index = 0; index < visible.size(); ++index) {
+      Segment3 clipped = visible[index];
       if (!ClipToFrustum(pose, camera, kNearClip, &clipped)) continue;
       const Eigen::Vector2d a = camera.Project(pose * clipped.a);
       const Eigen::Vector2d b = camera.Project(pose * clipped.b);
@@ -398,7 +400,7 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
       if (length < 2.0 * solve.end_margin_px + options.sample_step_px) continue;
       const Eigen::Vector2d d = (b - a) / length;
       const Eigen::Vector2d normal(-d.y(), d.x());
-      ViewedEdge edge{clipped.a, clipped.b, {}};
+      ViewedEdge edge{clipped.a, clipped.b, {}, static_cast<int>(index)};
       for (double s = solve.end_margin_px; s <= length - solve.end_margin_px;
            s += options.sample_step_px) {
         const Eigen::Vector2d p = a + s * d;
@@ -414,6 +416,8 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
     pose = step.cam_from_world;
     out.points = step.points;
     out.rms_after_px = step.rms_after_px;
+    out.observations = step.observations;
+    out.set_aside = step.set_aside;
   }
   out.applied = true;
   out.cam_from_world = pose;

@@ -50,6 +50,15 @@ struct KnownHeightTilt {
   double tilt = 0.0;
 };
 
+// One model edge and the sub-pixel edge points the refinement attached to it: the measurements
+// of the pose (tracking/integrity/ computes the pose's covariance and integrity from them).
+struct EdgeObservation {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // world (metres): the edge's part in view
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector2d> points;  // undistorted pixels
+  int model_edge = -1;                  // index of the edge in the refinement's input
+};
+
 // The outcome of RefineOnEdges.
 struct EdgeRefinement {
   bool applied = false;  // false: too few edge points, no improvement, or a refused correction
@@ -63,6 +72,9 @@ struct EdgeRefinement {
   // metres) and heading (radians), from the Gauss-Newton information and the residuals' scale.
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
+  // When applied: the edges and points of the final solve, and the edges set aside.
+  std::vector<EdgeObservation> observations;
+  std::vector<EdgeObservation> set_aside;
 };
 
 // Where a refinement starts: a pose and, for a robot, its known height and tilt (the result then
@@ -86,7 +98,7 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
 // Gauss-Newton refinement.
 struct EdgeAlignmentOptions {
   double sample_step_px = 6.0;  // distance between searches along a projected edge
-  double search_px = 12.0;      // first round's half search length
+  double search_px = 12.0;      // the first search pass: half its length
   int rounds = 2;
   EdgeRefinementOptions solve;  // later rounds search solve.search_px
 

@@ -219,8 +219,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
   health.edges_total = sites.total;
   health.edges_good = static_cast<int>(sites.good.size());
   if (settings_.refine_subpixel) {
-    const EdgeRefinement refined = RefineOnEdges(
-        image, camera_, edges_, sites.good, {result.cam_from_world, known}, settings_.refinement);
+    EdgeRefinement refined = RefineOnEdges(image, camera_, edges_, sites.good,
+                                           {result.cam_from_world, known}, settings_.refinement);
     health.refined = refined.applied;
     health.refined_points = refined.points;
     if (refined.applied) {
@@ -230,6 +230,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       health.refined_rejected_edges = refined.rejected_edges;
       health.refined_position_sigma_m = refined.position_sigma_m;
       health.refined_heading_sigma_deg = RadToDeg(refined.heading_sigma_rad);
+      result.observations = std::move(refined.observations);
+      result.set_aside = std::move(refined.set_aside);
     }
   }
   if (!with_covariance) return result;
@@ -240,7 +242,6 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       for (int k = 0; k < 6; ++k)
         c(r, k) = covariance[r][k];
     }
-    result.covariance = c;
     const Eigen::Vector2d sigmas = CovarianceSigmas(c);
     health.position_sigma_m = sigmas.x();
     health.rotation_sigma_deg = vpMath::deg(sigmas.y());

@@ -34,9 +34,10 @@ struct EdgeTrackResult {
   double passes_ms = 0.0;   // Track(): wall clock in ViSP's track() calls
   double measure_ms = 0.0;  // Track(): projection error read, moving-edge states, refinement,
                             // covariance
-  // Track() with_covariance: ViSP's covariance of the pose parameters (t, theta u) of cMo
-  // (vpMbTracker::getCovarianceMatrix), of ViSP's pose before the sub-pixel refinement.
-  std::optional<Eigen::Matrix<double, 6, 6>> covariance;
+  // Track() with the sub-pixel refinement applied: its edges and points (the measurements of the
+  // pose, for tracking/integrity/) and the edges it set aside.
+  std::vector<EdgeObservation> observations;
+  std::vector<EdgeObservation> set_aside;
 };
 
 // RMS image motion (pixels) of the model `edges` (world) between two poses: the edges are clipped
