@@ -1,5 +1,5 @@
 // The maths of app/ros/ros_geometry.h on exact synthetic poses: the camera mount, AMCL's
-// map -> odom correction, the pose covariance in ROS's convention, odometry
+// map -> odom correction, the pose covariance in ROS's convention, the status, odometry
 // interpolation and the matcher's bounds from RViz's initial pose covariance.
 #include "app/ros/ros_geometry.h"
 
@@ -7,6 +7,7 @@
 
 #include <array>
 
+#include "app/ros/ros_tracker.h"
 #include "models/geometry.h"
 
 namespace linetrack::app {
@@ -62,6 +63,16 @@ TEST(RosGeometry, PlanarTwistCovarianceIsTheBasesXYYaw) {
   const Eigen::Matrix3d z_roll_pitch = ros->block<3, 3>(2, 2);
   EXPECT_NEAR(z_roll_pitch.norm(), 0.0, kExact);  // z, roll, pitch: known
   EXPECT_FALSE(RosCovarianceOf(PoseUncertainty(), s.cam_from_map, s.mount).has_value());
+}
+
+// ~status of a frame with a pose: the integrity monitor's word, relocalising for a degraded pose
+// while the matcher's pose is being confirmed.
+TEST(RosGeometry, StatusFollowsTheIntegrityMonitor) {
+  EXPECT_EQ(StatusOf(IntegrityStatus::kTracking, /*reacquiring=*/false), RosStatus::kTracking);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kDegraded, /*reacquiring=*/false), RosStatus::kDegraded);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kDegraded, /*reacquiring=*/true), RosStatus::kRelocalising);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kLost, /*reacquiring=*/false), RosStatus::kLost);
+  EXPECT_STREQ(ToString(RosStatus::kRelocalising), "relocalising");
 }
 
 TEST(RosGeometry, OdometryIsInterpolatedAtTheImageStamp) {
