@@ -11,6 +11,8 @@
 #include <opencv2/core/version.hpp>
 
 #include "app/commands.h"
+#include "app/ros/bag_recording.h"
+#include "app/ros/ros_commands.h"
 #include "models/errors.h"
 
 namespace {
@@ -58,9 +60,11 @@ int main(int argc, char** argv) {
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
   app::AddBenchDrive(cli, &action);
-  app::AddReplay(cli, &action);
+  app::AddReplayWithRecordings(cli, &action, app::OpenRosBag);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddRos(cli, &action);
+  app::AddBenchRos(cli, &action);
 
   try {
     cli.parse(argc, argv);

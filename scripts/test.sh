@@ -15,6 +15,9 @@ scripts/setup.sh build -DLINETRACK_TEST_DATA="$data"
 
 scripts/setup.sh build-asan -DLINETRACK_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DLINETRACK_TEST_DATA="$data"
+# Leaks inside Debian's libraries (ROS, OpenCV, ViSP) are suppressed by library in
+# tests/lsan_suppressions.txt (also set per gtest binary by linetrack_add_test).
 (cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  LSAN_OPTIONS="suppressions=$PWD/../tests/lsan_suppressions.txt" \
   ctest --output-on-failure -j "$jobs")
 echo "test: all suites passed"

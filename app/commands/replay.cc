@@ -20,6 +20,7 @@
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "app/recording.h"
 #include "app/replay_output.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
@@ -45,9 +46,15 @@ struct ReplayOptions {
   bool align_times = false;  // time_offset = first prior (or ground-truth) time - first frame's
   long max_frames = 0;
   bool overlay_png = false, no_overlay = false, scanline = false;
-  LineFlags lines;  // the line extractor of the re-localisation
-  IntegrityFlags integrity;
+  LineFlags lines;             // the line extractor of the re-localisation
+  IntegrityFlags integrity;    // the alert limit and the sigmas of the pose integrity
+  RecordingOptions recording;  // a rosbag input (--image-topic ...)
+  RecordingOpener open_recording;
 };
+
+bool IsRecording(const std::string& input) {
+  return input.size() > 4 && input.compare(input.size() - 4, 4, ".bag") == 0;
+}
 
 double Milliseconds(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
@@ -102,11 +109,72 @@ struct ReplaySetup {
   std::optional<Pose3Dof> initial_prior;
   bool robot = false;
   std::unique_ptr<GroundTruth> ground_truth;
-  std::unique_ptr<VideoSource> source;
+  std::unique_ptr<VideoSource> video;
+  std::unique_ptr<Recording> recording;
+  FrameSource* source = nullptr;  // the video's or the recording's frames
+  long frame_count = 0;
   Frame first;
   double fps = 30.0;
   double time_offset = 0.0;  // --time-offset or --align-times
 };
+
+TrackerSettings ReadSettings(const ReplayOptions& opt) {
+  TrackerSettings base;
+  base.visibility.scanline = opt.scanline;
+  return opt.settings.empty() ? base : ReadTrackerSettings(opt.settings, base);
+}
+
+// Reads the first frame; the camera takes its size, or must have it.
+void GrabFirstFrame(const ReplayOptions& opt, ReplaySetup* s) {
+  if (s->source->Grab(&s->first) != FrameStatus::kOk) {
+    throw InputError(opt.input + ": no frame can be read");
+  }
+  const int width = static_cast<int>(s->first.image.getWidth());
+  const int height = static_cast<int>(s->first.image.getHeight());
+  if (s->camera.width <= 0) {
+    s->camera.width = width;
+    s->camera.height = height;
+  } else if (s->camera.width != width || s->camera.height != height) {
+    throw InputError((opt.camera.empty() ? opt.input : opt.camera) + ": the camera is " +
+                     std::to_string(s->camera.width) + "x" + std::to_string(s->camera.height) +
+                     ", the frames of " + opt.input + " are " + std::to_string(width) + "x" +
+                     std::to_string(height));
+  }
+}
+
+// A recording (rosbag): its odometry is the prior file, --prior moves it to the map.
+void PrepareRecording(const ReplayOptions& opt, ReplaySetup* s) {
+  if (!opt.open_recording) throw InputError(opt.input + ": this build cannot read rosbag files");
+  if (!opt.prior_file.empty()) throw InputError("replay: a bag's odometry replaces --prior-file");
+  if (opt.recording.image_topic.empty()) throw InputError("replay: a bag needs --image-topic");
+  if (!opt.has_height) throw InputError("replay: a bag needs --height");
+  CheckHeight(opt.height, "--height");
+  if (opt.has_tilt) CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
+  if (!opt.has_tilt && opt.recording.joint_states_topic.empty()) {
+    throw InputError("replay: a bag needs --tilt or --joint-states-topic");
+  }
+  RecordingOptions options = opt.recording;
+  options.height = opt.height;
+  options.tilt = opt.has_tilt ? DegToRad(opt.tilt_deg) : 0.0;
+  if (!opt.prior.empty()) options.start = ParsePrior(opt.prior, "--prior");
+  s->recording = opt.open_recording(opt.input, options);
+  s->priors = s->recording->priors();
+  s->robot = true;
+  if (s->priors.empty()) {  // no odometry: --prior starts it, the fixed tilt holds
+    if (opt.prior.empty()) throw InputError("replay: a bag without --odom-topic needs --prior");
+    if (!opt.has_tilt) throw InputError("replay: a bag without odometry needs --tilt");
+    s->initial_prior = ParsePrior(opt.prior, "--prior");
+  }
+  if (opt.camera.empty()) {
+    if (!s->recording->camera()) throw InputError("replay: give --camera or --camera-info-topic");
+    s->camera = *s->recording->camera();
+  } else {
+    s->camera = LoadCamera(opt.camera);
+  }
+  s->source = &s->recording->frames();
+  s->frame_count = s->recording->FrameCount();
+  s->fps = s->recording->FrameRate();
+}
 
 // The offset between the frames' times and those of the prior file and ground truth (given, or
 // aligning the first stamps), then a check that they overlap (one line, exit 2, when not).
@@ -136,14 +204,24 @@ void AlignTimes(const ReplayOptions& opt, long frames, ReplaySetup* s) {
     return times;
   };
   const double tolerance = 1.0 / s->fps + 0.5;
-  CheckTimesOverlap(shifted(prior_times), first, last, tolerance,
-                    opt.prior_file + ": --prior-file");
+  CheckTimesOverlap(
+      shifted(prior_times), first, last, tolerance,
+      s->recording ? opt.input + ": the odometry" : opt.prior_file + ": --prior-file");
   CheckTimesOverlap(shifted(truth_times), first, last, tolerance,
                     opt.ground_truth + ": --ground-truth");
 }
 
 ReplaySetup Prepare(const ReplayOptions& opt) {
   ReplaySetup s;
+  if (IsRecording(opt.input)) {
+    PrepareRecording(opt, &s);
+    s.settings = ReadSettings(opt);
+    s.ground_truth = std::make_unique<GroundTruth>(opt.ground_truth);
+    GrabFirstFrame(opt, &s);
+    AlignTimes(opt, s.frame_count, &s);
+    return s;
+  }
+  if (opt.camera.empty()) throw InputError("replay: --camera is required");
   const bool has_prior = !opt.prior.empty();
   if (has_prior && !opt.prior_file.empty()) {
     throw InputError("replay: give either --prior-file or --prior, not both");
@@ -168,9 +246,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
   s.camera = LoadCamera(opt.camera);
-  TrackerSettings base;
-  base.visibility.scanline = opt.scanline;
-  s.settings = opt.settings.empty() ? base : ReadTrackerSettings(opt.settings, base);
+  s.settings = ReadSettings(opt);
   if (!opt.prior_file.empty()) s.priors = ReadPriors(opt.prior_file);
   if (!opt.init_pose.empty()) s.start_pose = ReadPoseFile(opt.init_pose);
   s.ground_truth = std::make_unique<GroundTruth>(opt.ground_truth);
@@ -188,22 +264,12 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
     const double step = MedianTimeStep(times);
     if (step > 0.0) source_options.frame_rate = 1.0 / step;
   }
-  s.source = std::make_unique<VideoSource>(opt.input, source_options);
-  if (s.source->Grab(&s.first) != FrameStatus::kOk) {
-    throw InputError(opt.input + ": no frame can be read");
-  }
-  const int width = static_cast<int>(s.first.image.getWidth());
-  const int height = static_cast<int>(s.first.image.getHeight());
-  if (s.camera.width <= 0) {
-    s.camera.width = width;
-    s.camera.height = height;
-  } else if (s.camera.width != width || s.camera.height != height) {
-    throw InputError(opt.camera + ": the camera is " + std::to_string(s.camera.width) + "x" +
-                     std::to_string(s.camera.height) + ", the frames of " + opt.input + " are " +
-                     std::to_string(width) + "x" + std::to_string(height));
-  }
+  s.video = std::make_unique<VideoSource>(opt.input, source_options);
+  s.source = s.video.get();
+  s.frame_count = s.video->FrameCount();
+  GrabFirstFrame(opt, &s);
   s.fps = source_options.frame_rate > 0.0 ? source_options.frame_rate : 30.0;
-  AlignTimes(opt, s.source->FrameCount(), &s);
+  AlignTimes(opt, s.frame_count, &s);
   return s;
 }
 
@@ -358,7 +424,7 @@ ReplayFrameRecord RecordFrame(const Frame& frame, const FrameReport& report, con
   return record;
 }
 
-// Processes one frame: tracks it, logs it and draws its overlay.
+// Processes one frame: tracks it, logs it (and into the output bag) and draws its overlay.
 void ProcessFrame(const ReplayOptions& opt, const ReplaySetup& s, const Frame& frame,
                   ReplayTracking* tracking, ReplayRun* run) {
   SequenceTracker& sequence = tracking->sequence();
@@ -370,6 +436,7 @@ void ProcessFrame(const ReplayOptions& opt, const ReplaySetup& s, const Frame& f
   record.decode_ms = run->decode_ms;
   run->with_pose += record.has_pose ? 1 : 0;
   run->log.Add(record, report);
+  if (s.recording) s.recording->Add(record.t, report);
   run->records.push_back(record);
   if (!run->overlay) return;
   const Clock::time_point overlay_start = Clock::now();
@@ -455,7 +522,7 @@ int RunReplay(const ReplayOptions& opt) {
   EnsureDirectory(opt.out);
   ReplayRun run(opt, s);
   StopSignals signals;
-  Progress progress(opt.max_frames > 0 ? opt.max_frames : s.source->FrameCount(),
+  Progress progress(opt.max_frames > 0 ? opt.max_frames : s.frame_count,
                     spdlog::get_level() <= spdlog::level::info);
   run.info.interruption = "still running (a summary of a replay that stopped without finishing)";
   WriteSummary(tracking.sequence(), &run);
@@ -471,6 +538,7 @@ int RunReplay(const ReplayOptions& opt) {
     }
   } while (GrabNext(opt, s, &frame, &run));
   progress.Update(static_cast<long>(run.records.size()), run.with_pose, true);
+  if (s.recording) s.recording->Finish();
   FinishFiles(tracking.sequence(), &run);
   PrintReplayLine(tracking.sequence(), run);
   return run.info.complete && run.with_pose > 0 ? kExitOk : kExitJobFailed;
@@ -479,17 +547,23 @@ int RunReplay(const ReplayOptions& opt) {
 }  // namespace
 
 void AddReplay(CLI::App& cli, CommandAction* action) {
+  AddReplayWithRecordings(cli, action, {});
+}
+
+void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpener open_recording) {
   auto opt = std::make_shared<ReplayOptions>();
+  opt->open_recording = std::move(open_recording);
   CLI::App* cmd = cli.add_subcommand(
       "replay",
       "Track a recorded video or image sequence: started by the matcher from a robot prior (or "
       "from a ViSP pose file), recovered after losses; poses, per-frame log, overlay, summary");
-  cmd->add_option("--input", opt->input, "Video file or printf image pattern 'DIR/frame_%05d.png'")
+  cmd->add_option("--input", opt->input,
+                  "Video file, printf image pattern 'DIR/frame_%05d.png' or rosbag file (.bag)")
       ->required();
   cmd->add_option("--model", opt->model, "ViSP .cao model")->required();
   cmd->add_option("--camera", opt->camera,
-                  "Camera file: ViSP XML, OpenCV or ROS YAML (its distortion is undone)")
-      ->required();
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (its distortion is undone); a "
+                  "bag may give --camera-info-topic");
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option("--prior-file", opt->prior_file,
                   "Robot readings per time: CSV t,x,y,heading_deg,height,tilt_deg");
@@ -523,6 +597,18 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   AddIntegrityFlags(cmd, &opt->integrity);
   AddAllPosesFlag(cmd, &opt->integrity);
+  RecordingOptions& bag = opt->recording;
+  cmd->add_option("--image-topic", bag.image_topic, "Bag: sensor_msgs/Image topic");
+  cmd->add_option("--odom-topic", bag.odom_topic, "Bag: nav_msgs/Odometry topic (the prior)");
+  cmd->add_option("--camera-info-topic", bag.camera_info_topic,
+                  "Bag: sensor_msgs/CameraInfo topic (instead of --camera)");
+  cmd->add_option("--joint-states-topic", bag.joint_states_topic,
+                  "Bag: sensor_msgs/JointState topic of the pan-tilt head");
+  cmd->add_option("--pan-joint", bag.pan_joint, "Bag: the pan joint's name")->capture_default_str();
+  cmd->add_option("--tilt-joint", bag.tilt_joint, "Bag: the tilt joint's name")
+      ->capture_default_str();
+  cmd->add_option("--out-bag", bag.out_bag,
+                  "Bag: write the poses (PoseWithCovarianceStamped) and map -> odom (TF) here");
   cmd->add_flag("--scanline", opt->scanline,
                 "Scan-line visibility (hidden edge parts not tracked; about 4x slower)");
   cmd->callback([opt, action, cmd] {
@@ -538,6 +624,12 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
                  "applies to the matcher, which needs a robot's readings (--prior-file, or "
                  "--prior with --height and --tilt)");
     RefuseUnless(*cmd, !opt->no_overlay, {"--overlay-png"}, "not with --no-overlay");
+    RefuseUnless(*cmd, IsRecording(opt->input),
+                 {"--image-topic", "--odom-topic", "--camera-info-topic", "--joint-states-topic",
+                  "--pan-joint", "--tilt-joint", "--out-bag"},
+                 "applies to a rosbag input (--input RUN.bag)");
+    RefuseUnless(*cmd, !IsRecording(opt->input), {"--time-offset", "--align-times"},
+                 "not with a rosbag input (its odometry has the images' stamps)");
     *action = [opt] { return RunReplay(*opt); };
   });
 }

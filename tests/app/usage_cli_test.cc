@@ -42,6 +42,12 @@ TEST_F(UsageCli, FlagsThatCannotApplyAreRefused) {
        "--speed"},
       {"render --model " + kHall + " --camera c.xml --pose 1,2,3 --frames 10 --out " + out + ".png",
        "--frames"},
+      {"replay --input v.mp4 --model " + kHall + " --camera c.xml --init-pose p.pos " +
+           "--image-topic /camera/image_raw --out " + out,
+       "--image-topic"},
+      {"replay --input v.mp4 --model " + kHall + " --camera c.xml --init-pose p.pos --out-bag " +
+           out + ".bag --out " + out,
+       "--out-bag"},
   };
   for (const auto& [args, flag] : refused) {
     const CommandRun run = Linetrack(args);

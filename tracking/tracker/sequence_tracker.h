@@ -150,6 +150,9 @@ class SequenceTracker {
   int losses() const { return losses_; }
   const SequenceTrackerOptions& options() const { return options_; }
   int recoveries() const { return recoveries_; }
+  // A matcher's pose is being confirmed (ReacquisitionCheck): its poses are reported degraded
+  // until it is.
+  bool reacquiring() const { return reacquisition_.has_value(); }
 
  private:
   struct GoodPose {
