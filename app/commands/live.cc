@@ -41,7 +41,7 @@ struct LiveCommandOptions {
   std::string head_start, head_start_offset;
   std::string head_model = "ptu46";
   std::string estimator = "auto";
-  std::string settings;
+  std::string settings, mount;
   double height = -1.0;
   double duration = 0.0;
   bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
@@ -98,8 +98,13 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   if (!ParseHeadModel(opt.head_model, &plan.head_model)) {
     throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
   }
-  CheckRange(opt.height, 0.05, 100.0, "--height");
-  plan.height = opt.height;
+  if (opt.height < 0.0 && (opt.mount.empty() || plan.sim)) {
+    throw InputError("--height: needed (the camera height above the floor with the head level)");
+  }
+  if (opt.height >= 0.0) {
+    CheckRange(opt.height, 0.05, 100.0, "--height");
+    plan.height = opt.height;
+  }
   if (!opt.prior.empty() && !opt.prior_file.empty()) {
     throw InputError("--prior and --prior-file: give one of them");
   }
@@ -127,7 +132,6 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   }
   if (opt.snapshot_every < 0) throw InputError("--snapshot-every: must be >= 0");
   CheckRange(opt.max_rate_deg, 0.1, 360.0, "--max-rate");
-  plan.loop.servo.model = plan.head_model;
   plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
   plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
   CheckRange(plan.duration, 0.0, 1e7, "--duration");
@@ -208,6 +212,8 @@ int RunLive(const LiveCommandOptions& opt) {
     spdlog::warn("{}", w);
   inputs.model = &model;
   if (!opt.prior_file.empty()) inputs.priors = ReadPriors(opt.prior_file);
+  if (!opt.mount.empty()) inputs.mount = ReadMountFile(opt.mount);
+  inputs.mount_path = opt.mount;
   if (!opt.prior_file.empty() && inputs.priors.empty()) {
     throw InputError(opt.prior_file + ": no prior rows");
   }
@@ -297,6 +303,7 @@ int RunLive(const LiveCommandOptions& opt) {
   json["source"] = session.DescribeSource();
   json["head"] = session.DescribeHead();
   json["estimator"] = session.DescribeEstimator();
+  json["mount"] = session.DescribeMount();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
   output.Finish(json);
@@ -323,8 +330,12 @@ void AddLive(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
   cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (with its image size)")
       ->required();
-  cmd->add_option("--height", opt->height, "Camera height above the floor, head level (metres)")
-      ->required();
+  cmd->add_option("--height", opt->height,
+                  "Camera height above the floor, head level (metres; with a --mount that has a "
+                  "floor calibration it may be left out)");
+  cmd->add_option("--mount", opt->mount,
+                  "mount.json of linetrack calibrate-mount: the calibrated camera mount (and its "
+                  "floor height) instead of --head-model's nominal geometry (and --height)");
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option(
       "--prior", opt->prior,

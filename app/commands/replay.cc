@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/head_mount.h"
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
@@ -32,6 +33,7 @@ using Clock = std::chrono::steady_clock;
 
 struct ReplayOptions {
   std::string input, model, camera, prior_file, prior, init_pose, settings, ground_truth, out;
+  std::string mount;  // calibrated camera mount: the prior's tilt is the head's
   double height = std::nan(""), tilt_deg = std::nan("");
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
@@ -93,6 +95,7 @@ struct ReplaySetup {
   std::optional<Eigen::Isometry3d> start_pose;
   std::optional<Pose3Dof> initial_prior;
   bool robot = false;
+  std::optional<BelievedHead> head;  // --mount
   std::unique_ptr<GroundTruth> ground_truth;
   std::unique_ptr<VideoSource> source;
   Frame first;
@@ -106,15 +109,16 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
     throw InputError("replay: give either --prior-file or --prior, not both");
   }
   const bool has_height_tilt = std::isfinite(opt.height) || std::isfinite(opt.tilt_deg);
-  if ((has_prior || has_height_tilt) &&
-      !(std::isfinite(opt.height) && std::isfinite(opt.tilt_deg))) {
+  const bool height_known = std::isfinite(opt.height) || !opt.mount.empty();  // or its floor
+  if ((has_prior || has_height_tilt) && !(height_known && std::isfinite(opt.tilt_deg))) {
     throw InputError("replay: --prior needs both --height and --tilt");
   }
   if (!has_prior && opt.prior_file.empty() && opt.init_pose.empty()) {
     throw InputError("replay: nothing to start from: give --init-pose, --prior-file or --prior");
   }
   if (has_height_tilt) {
-    CheckRange(opt.height, 0.0, 100.0, "--height");
+    if (std::isfinite(opt.height) || opt.mount.empty())
+      CheckRange(opt.height, 0.0, 100.0, "--height");
     CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   }
   CheckRange(opt.delta_t, 0.0, 100.0, "--delta-t");
@@ -125,6 +129,11 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
   s.camera = ReadCameraXml(opt.camera);
+  if (!opt.mount.empty()) {
+    s.head =
+        BelieveHead(HeadModel::kPtu46, ReadMountFile(opt.mount), opt.mount,
+                    std::isfinite(opt.height) ? std::optional<double>(opt.height) : std::nullopt);
+  }
   TrackerSettings base;
   base.visibility.scanline = opt.scanline;
   s.settings = opt.settings.empty() ? base : ReadTrackerSettings(opt.settings, base);
@@ -172,11 +181,12 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
     reading.odometry = prior->Planar();
     reading.height = prior->height;
     reading.tilt = prior->tilt;
-    return reading;
+  } else {
+    reading.height = opt.height;
+    reading.tilt = DegToRad(opt.tilt_deg);
   }
-  reading.height = opt.height;
-  reading.tilt = DegToRad(opt.tilt_deg);
-  return reading;
+  // With a calibrated mount the tilt is the head's: the camera's height and tilt follow.
+  return s.head ? ReadingOnHead(*s.head, reading, reading.tilt) : reading;
 }
 
 // Prints a progress bar on stderr when it is a terminal, at most ten times a second.
@@ -377,6 +387,10 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
                   "Robot start prior X,Y,HEADING_DEG (with --height, --tilt)");
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
+  cmd->add_option("--mount", opt->mount,
+                  "mount.json of linetrack calibrate-mount: --tilt and the prior file's tilt are "
+                  "the head's, the camera's height and tilt follow from the mount (and its floor "
+                  "height, else --height taped with the head level)");
   cmd->add_option("--delta-t", opt->delta_t, "Position bound of the first prior (metres)")
       ->capture_default_str();
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Heading bound of the first prior (degrees)")

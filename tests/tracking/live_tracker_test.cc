@@ -70,7 +70,8 @@ TrackedRun RunWithTracker(const SimCameraOptions& camera, const LiveLoopOptions&
   SimHeadStart start;
   start.offset_from_target = start_offset;
   SimulatedLiveRig rig(TheHall().model, &TheHall().area, TheHall().camera, camera,
-                       SimulatedHeadOptions{}, loop, start, PoseJitterOptions{}, tracker.get());
+                       SimulatedHeadOptions{}, NominalBelief(camera, loop), start,
+                       PoseJitterOptions{}, tracker.get());
   TrackedRun run;
   for (int k = 0; k < frames; ++k) {
     run.iterations.push_back(rig.loop().Step());

@@ -75,7 +75,7 @@ LiveLoop::LiveLoop(FrameSource* source, PanTiltHead* head, CameraPoseEstimator* 
       occlusion_(model),
       camera_(camera),
       options_(options),
-      geometry_(GeometryOf(options.servo.model)),
+      geometry_(options.servo.geometry),
       limits_(head->Limits()),
       servo_(options.servo),
       target_(options.target) {
