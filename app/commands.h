@@ -21,5 +21,6 @@ void AddBenchTrack(CLI::App& cli, CommandAction* action);
 void AddReplay(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
+void AddCalibrateMount(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddCalibrateMount(cli, &action);
 
   try {
     cli.parse(argc, argv);
