@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
+  app::AddBenchDrive(cli, &action);
   app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);

@@ -11,6 +11,15 @@
 
 namespace linetrack {
 
+// The whole text of a file; throws InputError naming it ("no such `what` file", "cannot read").
+std::string ReadTextFile(const std::string& path, const std::string& what);
+
+// Exactly `count` finite numbers separated by `sep` (' ' means any run of blanks; fields are
+// trimmed). Throws InputError naming path:line_no and, on a wrong count, the `layout`.
+std::vector<double> ParseNumberFields(const std::string& line, char sep, size_t count,
+                                      const std::string& path, int line_no,
+                                      const std::string& layout);
+
 // One pose of a trajectory: time (seconds) and the pose of the camera frame (ViSP axes) in the
 // world frame, world_from_cam (the inverse of cam_from_world).
 struct StampedPose {

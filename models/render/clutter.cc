@@ -55,12 +55,7 @@ bool FreeAt(const NavigableArea& area, const Eigen::Vector3d& p) {
 }
 
 RenderSurface Solid(std::vector<Eigen::Vector3d> polygon, double albedo, bool decal = false) {
-  RenderSurface s;
-  s.kind = SurfaceKind::kClutter;
-  s.normal = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]).normalized();
-  s.offset = s.normal.dot(polygon[0]);
-  s.polygon = std::move(polygon);
-  s.albedo = std::clamp(albedo, 0.0, 1.0);
+  RenderSurface s = PlanarSurface(std::move(polygon), SurfaceKind::kClutter, albedo);
   s.decal = decal;
   return s;
 }
