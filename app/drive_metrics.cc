@@ -165,6 +165,7 @@ DriveMetrics ComputeDriveMetrics(const std::vector<FrameTruth>& truth,
     m.observable_tracking += observable && tracking;
     m.poses_unobservable += !observable;
     m.beyond_near += Beyond(f, options.near_m, options.near_deg);
+    m.tracking_beyond_near += f.status == "tracking" && Beyond(f, options.near_m, options.near_deg);
     m.beyond_far += Beyond(f, options.far_m, options.far_deg);
     const double e = f.translation_error_m.value_or(0.0), r = f.rotation_error_deg.value_or(0.0);
     squares += e * e;
@@ -228,6 +229,8 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
   row("poses beyond " + near, [](const DriveMetrics& m, const auto&) {
     return std::to_string(m.beyond_near) + " of " + std::to_string(m.poses);
   });
+  row("`tracking` poses beyond " + near,
+      [](const DriveMetrics& m, const auto&) { return std::to_string(m.tracking_beyond_near); });
   row("poses beyond " + far,
       [](const DriveMetrics& m, const auto&) { return std::to_string(m.beyond_far); });
   row("poses on unobservable frames",
@@ -245,8 +248,7 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
   });
   row("odometry drift (largest over 10 m)",
       [](const DriveMetrics&, const DriveReport& r) { return Fixed(r.drift_percent, 2) + " %"; });
-  // The integrity monitor's figures: printed once replay writes protection levels and
-  // covariances (frames.csv, covariance.jsonl).
+  // The integrity monitor's figures (replay's summary.json, "integrity").
   row("integrity failures (`tracking` beyond its protection level)",
       [](const DriveMetrics& m, const auto&) {
         return m.integrity_failures ? std::to_string(*m.integrity_failures) : "n/a";
@@ -255,6 +257,25 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
       [](const DriveMetrics& m, const auto&) {
         return m.nees_within_99 ? Fixed(100.0 * *m.nees_within_99, 1) + " %" : "n/a";
       });
+  row("NEES (x, y, heading) within chi2(3) 50 / 90 / 99 / 99.9 %; mean (3)",
+      [](const DriveMetrics& m, const auto&) -> std::string {
+        if (!m.nees_within_99) return "n/a";
+        std::string text;
+        for (double share : m.nees_shares)
+          text += (text.empty() ? "" : " / ") + Fixed(100.0 * share, 1);
+        return text + " %; " + Fixed(m.mean_nees, 2);
+      });
+  row("median sigma / median error (position)", [](const DriveMetrics& m, const auto&) {
+    return m.nees_within_99 ? Fixed(100.0 * m.median_sigma_m, 2) + " / " +
+                                  Fixed(100.0 * m.median_error_m, 2) + " cm"
+                            : "n/a";
+  });
+  row("sigma x p50 / p90; sigma heading p50", [](const DriveMetrics& m, const auto&) {
+    return m.nees_within_99
+               ? Fixed(100.0 * m.sigma_x_p50_m, 2) + " / " + Fixed(100.0 * m.sigma_x_p90_m, 2) +
+                     " cm; " + Fixed(m.sigma_heading_p50_deg, 3) + " deg"
+               : "n/a";
+  });
 
   std::string out = "| |";
   std::string rule = "| --- |";
@@ -270,6 +291,26 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
     out += "\n";
   }
   return out;
+}
+
+void AddIntegrityFigures(const nlohmann::json& integrity, DriveMetrics* m) {
+  if (!integrity.is_object() || !integrity.contains("ground_truth")) return;
+  const nlohmann::json& g = integrity["ground_truth"];
+  m->integrity_failures = g.value("integrity_failures", 0);
+  const nlohmann::json& regions = g["regions"];
+  for (size_t i = 0; i < m->nees_shares.size() && i < regions.size(); ++i)
+    m->nees_shares[i] = regions[i].value("share_inside", 0.0);
+  m->nees_within_99 = m->nees_shares[2];
+  m->mean_nees = g.value("mean_nees", 0.0);
+  m->median_sigma_m = g.value("median_sigma_m", 0.0);
+  m->median_error_m = g.value("median_error_m", 0.0);
+  auto p = [&](const char* key, const char* q) {
+    return integrity.contains(key) && integrity[key].is_object() ? integrity[key].value(q, 0.0)
+                                                                 : 0.0;
+  };
+  m->sigma_x_p50_m = p("sigma_x_m", "p50");
+  m->sigma_x_p90_m = p("sigma_x_m", "p90");
+  m->sigma_heading_p50_deg = p("sigma_heading_deg", "p50");
 }
 
 std::string FormatWorstFrames(const DriveMetrics& metrics, const std::vector<FrameTruth>& truth,

@@ -3,6 +3,8 @@
 // ATE, recovery after blackouts, replay speed; and the markdown tables that show them.
 #pragma once
 
+#include <array>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
@@ -52,16 +54,21 @@ struct DriveMetrics {
   int poses = 0;
   int poses_unobservable = 0;  // poses on frames that are not observable
   int beyond_near = 0, beyond_far = 0;
-  double ate_m = 0.0;  // RMSE of the camera-centre errors of the frames with a pose
+  int tracking_beyond_near = 0;  // poses `tracking` beyond the near bounds
+  double ate_m = 0.0;            // RMSE of the camera-centre errors of the frames with a pose
   double worst_m = 0.0, worst_deg = 0.0;
   long worst_m_frame = -1, worst_deg_frame = -1;
   std::vector<BlackoutRecovery> recoveries;
   double tracking_fps = 0.0;         // tracking frames over their summed step time
   double overall_fps = 0.0;          // the replay's throughput (decoding and every step)
   std::vector<size_t> worst_frames;  // indexes into the replayed frames, worst first
-  // Filled once replay reports them (protection levels, covariances); n/a until then.
+  // From replay's summary "integrity" (AddIntegrityFigures); n/a without it.
   std::optional<int> integrity_failures;
   std::optional<double> nees_within_99;
+  std::array<double, 4> nees_shares = {};  // within chi2(3) 50, 90, 99, 99.9 %
+  double mean_nees = 0.0;
+  double median_sigma_m = 0.0, median_error_m = 0.0;
+  double sigma_x_p50_m = 0.0, sigma_x_p90_m = 0.0, sigma_heading_p50_deg = 0.0;
 
   double Availability() const;          // observable frames with a pose / observable frames
   double TrackingAvailability() const;  // ... with a `tracking` pose
@@ -72,6 +79,10 @@ struct DriveMetrics {
 DriveMetrics ComputeDriveMetrics(const std::vector<FrameTruth>& truth,
                                  const std::vector<ReplayedFrame>& replayed, double overall_fps,
                                  const DriveMetricsOptions& options = {});
+
+// Reads replay's summary.json "integrity" (with ground truth) into `metrics`: integrity failures,
+// the NEES calibration against chi2(3), the sigma quantiles. Leaves them n/a when absent.
+void AddIntegrityFigures(const nlohmann::json& integrity, DriveMetrics* metrics);
 
 // A named drive's figures for the tables.
 struct DriveReport {

@@ -65,9 +65,10 @@ LiveSession::LiveSession(const LivePlan& plan, const LiveInputs& inputs) {
       if (!head.Check(&why)) throw InputError("--head-start: " + why);
     }
     start.offset_from_target = plan.head_start_offset;
-    rig_ = std::make_unique<SimulatedLiveRig>(*inputs.model, inputs.area, inputs.camera,
-                                              plan.sim_camera, head, loop, start,
-                                              PoseJitterOptions{}, tracker_.get());
+    rig_ = std::make_unique<SimulatedLiveRig>(
+        *inputs.model, inputs.area, inputs.camera,
+        SimulatedLiveRigOptions{plan.sim_camera, head, loop, start, PoseJitterOptions{}},
+        tracker_.get());
     return;
   }
   OpenDevices(plan, loop, inputs);
@@ -108,8 +109,9 @@ void LiveSession::OpenDevices(const LivePlan& plan, const LiveLoopOptions& loop,
       return PriorAt(priors, t - **first_t);
     };
   }
-  loop_ = std::make_unique<LiveLoop>(source_.get(), head_.get(), tracker_.get(), odometry,
-                                     *inputs.model, inputs.camera.Undistorted(), loop);
+  loop_ = std::make_unique<LiveLoop>(
+      LiveLoopParts{source_.get(), head_.get(), tracker_.get(), odometry}, *inputs.model,
+      inputs.camera.Undistorted(), loop);
 }
 
 LiveSession::~LiveSession() = default;

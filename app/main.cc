@@ -38,7 +38,9 @@ int main(int argc, char** argv) {
       "linetrack"};
   cli.set_version_flag("--version", VersionText(), "Print the version and exit");
   cli.require_subcommand(1);
-  cli.fallthrough(false);
+  // Global flags (-q) are accepted after the subcommand too: its subcommands (inheriting this)
+  // hand the options they do not know up to here.
+  cli.fallthrough(true);
   bool quiet = false;
   cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
 

@@ -181,10 +181,11 @@ void WriteSequence(const std::string& out, const WireframeModel& model, SceneRen
                       SequenceJson(*sequence, observable).dump(2) + "\n");
   WriteCameraAtomically((dir / "camera.xml").string(), undistorted ? camera.Undistorted() : camera);
   std::cout << "wrote " << count << " frames (" << camera.width << "x" << camera.height << ") to "
-            << out << ": median " << std::fixed << std::setprecision(1) << QuantileNearestRank(render_ms, 0.5)
-            << " ms per frame to render and judge, " << QuantileNearestRank(total_ms, 0.5)
-            << " ms with PNG encoding and writing; " << observable << " observable; odometry drift "
-            << std::setprecision(2) << 100.0 * sequence->drift.whole_share << " % over the run, "
+            << out << ": median " << std::fixed << std::setprecision(1)
+            << QuantileNearestRank(render_ms, 0.5) << " ms per frame to render and judge, "
+            << QuantileNearestRank(total_ms, 0.5) << " ms with PNG encoding and writing; "
+            << observable << " observable; odometry drift " << std::setprecision(2)
+            << 100.0 * sequence->drift.whole_share << " % over the run, "
             << 100.0 * sequence->drift.max_share << " % at most over " << kDriftWindowM << " m"
             << std::endl;
 }

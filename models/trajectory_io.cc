@@ -150,7 +150,10 @@ std::vector<PriorRecord> ParsePriors(const std::string& text, const std::string&
       continue;
     }
     const std::vector<double> v = ParseNumberFields(line, ',', 6, path, line_no, kPriorCsvHeader);
-    if (v[4] < 0.0) throw InputError(Located(path, line_no, "height must be >= 0"));
+    if (v[4] <= 0.0) {
+      throw InputError(
+          Located(path, line_no, "height: not a camera height (metres above the floor, > 0)"));
+    }
     if (std::abs(v[5]) > 90.0)
       throw InputError(Located(path, line_no, "tilt must be in [-90, 90]"));
     CheckIncreasing(v[0], records.empty(), records.empty() ? 0.0 : records.back().t, path, line_no);

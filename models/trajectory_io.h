@@ -39,7 +39,7 @@ std::vector<StampedPose> ReadTum(const std::string& path);
 std::string FormatTum(const std::vector<StampedPose>& poses);
 
 // One row of a prior file: time (seconds) and the prior pose (x, y metres; heading, tilt radians
-// in memory, degrees in the file; height metres), conventions of method.md.
+// in memory, degrees in the file; height metres), conventions of docs/conventions.md.
 struct PriorRecord {
   double t = 0.0;
   RobotPose pose;

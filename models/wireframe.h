@@ -29,6 +29,9 @@ struct ModelEdge {
   bool vertical = false;
   bool from_line = false;  // true: a 3D line of the file; false: first seen as a face edge
   int face = -1;           // first face the edge belongs to, -1 for a free 3D line
+  // The name="..." of its 3D line; else the names of the named faces it borders, joined by '/'
+  // ("wall_south/wall_east"); "" when none is named.
+  std::string name;
 };
 
 // A planar face (polygon) of the model. The normal follows ViSP's convention: the right-hand rule
@@ -40,6 +43,7 @@ struct ModelFace {
   double offset = 0.0;                               // plane: normal . X = offset
   bool vertical = false;                             // the plane contains the z direction (a wall)
   bool horizontal = false;                           // the plane is z = const (a floor or ceiling)
+  std::string name;                                  // its name="..." in the file ("" without)
 
   bool Degenerate() const { return normal.isZero(); }
 };

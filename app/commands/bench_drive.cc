@@ -227,6 +227,7 @@ DriveReport ReplayDrive(const DriveSpec& d, const fs::path& dir, const BenchDriv
   report.name = d.name;
   report.metrics =
       ComputeDriveMetrics(*truth, *replayed, summary.value("throughput_fps", 0.0), opt.metrics);
+  if (summary.contains("integrity")) AddIntegrityFigures(summary["integrity"], &report.metrics);
   report.drift_percent = sequence["odometry_drift"].value("max_percent", 0.0);
   return report;
 }
@@ -265,7 +266,10 @@ int RunBenchDrive(const BenchDriveOptions& opt) {
                     {"worst_deg", m.worst_deg},
                     {"tracking_fps", m.tracking_fps},
                     {"overall_fps", m.overall_fps},
-                    {"odometry_drift_percent", reports.back().drift_percent}});
+                    {"odometry_drift_percent", reports.back().drift_percent},
+                    {"tracking_beyond_near", m.tracking_beyond_near},
+                    {"integrity_failures", m.integrity_failures ? *m.integrity_failures : -1},
+                    {"nees_shares", m.nees_shares}});
   }
   double load[1] = {0.0};
   const bool has_load = getloadavg(load, 1) == 1;

@@ -224,7 +224,7 @@ FloorCalibration Floor(const MountInputs& in, const MountCalibration& mount,
 
 int RunCalibrateMount(CalibrateMountCommandOptions opt) {
   CheckOptions(&opt);
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
+  const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
   MountInputs in = LoadInputs(opt, camera);
@@ -283,7 +283,9 @@ void AddCalibrateMount(CLI::App& cli, CommandAction* action) {
       "it; writes mount.json (for live/replay --mount), eMc.yaml and residuals.png into --out");
   cmd->add_option("--images", opt->images, "Image files or glob patterns of the standing board");
   cmd->add_option("--angles", opt->angles_path, "ANGLES.csv: image,pan_deg,tilt_deg");
-  cmd->add_option("--camera", opt->camera_path, "The camera's ViSP XML (linetrack calibrate)")
+  cmd->add_option(
+         "--camera", opt->camera_path,
+         "Camera file: ViSP XML (linetrack calibrate), OpenCV or ROS YAML, with its image size")
       ->required();
   cmd->add_option("--pattern", opt->pattern, "chessboard, circles or charuco")
       ->capture_default_str();

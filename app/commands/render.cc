@@ -153,7 +153,7 @@ int RunRender(RenderCommandOptions opt) {
   if (form == kView && !EndsWithPng(opt.out))
     throw InputError("--out: one view is written as a .png file");
   const Pose3Dof planar = form == kView ? ParsePrior(opt.pose, "--pose") : Pose3Dof();
-  CheckRange(opt.height, 0.0, 100.0, "--height");
+  CheckHeight(opt.height, "--height");
   CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   if (opt.sequence.frames < 0) throw InputError("--frames: must be >= 0");
   opt.sequence.height = opt.height;
@@ -163,7 +163,7 @@ int RunRender(RenderCommandOptions opt) {
   CheckSequenceFlags(opt.sequence);
   const RenderOptions render_options = ImageOptions(opt);
 
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
+  const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
   const WireframeModel model = WireframeModel::Load(opt.model_path);

@@ -102,7 +102,7 @@ void SceneRenderer::Impl::Rasterize(const Eigen::Isometry3d& cam_from_world,
     const RenderSurface& surface = scene.surfaces[s];
     // Plane n . X = d in the world: (R n) . X_cam = d - n . C in the camera.
     facing[s] = PlaneInverseDepth(r * surface.normal, surface.offset - surface.normal.dot(centre),
-                                  cam.px, cam.py, cam.u0, cam.v0, &coeffs[s]);
+                                  {cam.px, cam.py, cam.u0, cam.v0}, &coeffs[s]);
   }
   zbuffer.Resize(cam.width, cam.height);
   zbuffer.ClearToPlanes(

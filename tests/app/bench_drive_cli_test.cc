@@ -26,8 +26,9 @@ TEST_F(BenchDriveCli, ATinyDriveGivesTheTable) {
        {"| | tiny-hall |", "| frames (observable) | 20 (",
         "| availability: observable frames with a pose |",
         "| frames to recover after each blackout |", "| ATE (camera centre RMSE) |",
-        "| integrity failures (`tracking` beyond its protection level) | n/a |",
-        "### tiny-hall: worst frames"}) {
+        "| integrity failures (`tracking` beyond its protection level) | 0 |",
+        "| NEES (x, y, heading) within chi2(3) 50 / 90 / 99 / 99.9 %; mean (3) |",
+        "| `tracking` poses beyond 10 cm / 2 deg | 0 |", "### tiny-hall: worst frames"}) {
     EXPECT_NE(run.out.find(row), std::string::npos) << row << "\n" << run.out;
   }
   EXPECT_TRUE(fs::exists(work / "tiny-hall" / "frames" / "frame_00019.png"));

@@ -77,13 +77,15 @@ TEST(SimulatedBracket, TheLoopsPriorFollowsTheBelievedGeometry) {
   LiveLoopOptions loop;
   loop.target = Eigen::Vector3d(9.25, 2.75, 1.5);
   const WireframeModel hall = WireframeModel::Load(kSource + "/models/hall.cao");
-  SimulatedLiveRig nominal(hall, nullptr, WideCamera(), sim, SimulatedHeadOptions{},
-                           NominalBelief(sim, loop));
+  SimulatedLiveRig nominal(
+      hall, nullptr, WideCamera(),
+      SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, NominalBelief(sim, loop), {}, {}});
   HeadGeometry truth = GeometryOf(HeadModel::kPtu46);
   truth.tilt_from_camera = MovedPose(truth.tilt_from_camera, Bracket());
   loop.servo.geometry = truth;
   loop.crossing_height = CrossingHeightFor(truth, sim.camera_height);
-  SimulatedLiveRig calibrated(hall, nullptr, WideCamera(), sim, SimulatedHeadOptions{}, loop);
+  SimulatedLiveRig calibrated(hall, nullptr, WideCamera(),
+                              SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, loop, {}, {}});
   const LiveIteration a = nominal.loop().Step(), b = calibrated.loop().Step();
   const RobotPose seen = RobotPoseFromCamFromWorld(calibrated.camera().last_cam_from_world());
   EXPECT_NEAR(b.camera_prior.tilt, seen.tilt, 1e-9);

@@ -2,7 +2,7 @@
 // look at a world point. Frames: the head's base frame has its origin where the pan and tilt axes
 // cross, x forward along the robot's heading, z up when the base is level (head_kinematics.h);
 // the camera pose on it is BaseFromCamera(geometry, pan, tilt). Conventions of
-// ../shared/docs/method.md.
+// docs/conventions.md.
 #pragma once
 
 #include <Eigen/Geometry>

@@ -48,6 +48,7 @@ PoseEstimate TrackerPoseEstimator::Estimate(const Frame& frame, const HeadState&
   estimate.cam_from_world = last_report_.cam_from_world;
   estimate.source = last_report_.source;
   estimate.note = last_report_.note;
+  estimate.uncertainty = last_report_.uncertainty;
   if (last_report_.health_measured) {
     estimate.projection_error_deg = last_report_.health.projection_error_deg;
   }

@@ -315,6 +315,17 @@ PoseEstimate SimulatorTruthEstimator::Estimate(const Frame& frame, const HeadSta
     pose = noise * pose;
   }
   estimate.cam_from_world = pose;
+  // The truth (with its stated jitter): its covariance the jitter's, its protection levels five
+  // sigmas (chi2(3) beyond 25: 1.5e-5).
+  estimate.uncertainty.status = IntegrityStatus::kTracking;
+  estimate.uncertainty.world_covariance.setZero();
+  estimate.uncertainty.world_covariance.diagonal()
+      << Eigen::Vector3d::Constant(jitter_.translation_sigma * jitter_.translation_sigma),
+      Eigen::Vector3d::Constant(jitter_.rotation_sigma * jitter_.rotation_sigma);
+  estimate.uncertainty.sigma_x_m = estimate.uncertainty.sigma_y_m = jitter_.translation_sigma;
+  estimate.uncertainty.sigma_heading_rad = jitter_.rotation_sigma;
+  estimate.uncertainty.protection_position_m = 5.0 * jitter_.translation_sigma;
+  estimate.uncertainty.protection_rotation_rad = 5.0 * jitter_.rotation_sigma;
   had_pose_ = true;
   lost_ = false;
   return estimate;
