@@ -25,5 +25,6 @@ void AddReplay(CLI::App& cli, CommandAction* action);
 void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpener open_recording);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
+void AddCalibrateMount(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   app::AddBenchServo(cli, &action);
   app::AddRos(cli, &action);
   app::AddBenchRos(cli, &action);
+  app::AddCalibrateMount(cli, &action);
 
   try {
     cli.parse(argc, argv);

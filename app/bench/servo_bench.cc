@@ -6,6 +6,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/statistics.h"
+#include "tracking/head/head_pointing.h"
 #include "tracking/sim/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -92,9 +93,9 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
   SimCameraOptions sim;
   sim.fps = options.fps;
   sim.render = options.render;
-  sim.head_model = options.servo.model;
   LiveLoopOptions loop;
   loop.servo = options.servo;
+  loop.crossing_height = CrossingHeightFor(loop.servo.geometry, sim.camera_height);
   // A fresh tracker per run (null: the simulator's truth).
   auto MakeTracker = [&]() -> std::unique_ptr<TrackerPoseEstimator> {
     if (!options.use_tracker) return nullptr;

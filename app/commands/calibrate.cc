@@ -1,7 +1,6 @@
 // `linetrack calibrate`: camera calibration from image files or a frame source (Zhang's method
 // through ViSP, OpenCV's model beside it), and `linetrack bench calibrate` (its timing).
 // docs/calibration.md.
-#include <glob.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/image_arguments.h"
 #include "calibration/output_files.h"
 #include "models/errors.h"
 #include "models/statistics.h"
@@ -38,34 +38,6 @@ struct CalibrateCommandOptions {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-bool HasGlobCharacters(const std::string& text) {
-  return text.find_first_of("*?[") != std::string::npos;
-}
-
-// Expands each argument as a glob (sorted matches); arguments without wildcards stay as they
-// are. Throws InputError for a wildcard pattern that matches no file.
-std::vector<std::string> ExpandImageArguments(const std::vector<std::string>& arguments) {
-  std::vector<std::string> paths;
-  for (const std::string& arg : arguments) {
-    if (!HasGlobCharacters(arg)) {
-      paths.push_back(arg);
-      continue;
-    }
-    glob_t matches{};
-    const int status = ::glob(arg.c_str(), 0, nullptr, &matches);
-    std::vector<std::string> found;
-    if (status == 0) {
-      for (size_t i = 0; i < matches.gl_pathc; ++i)
-        found.emplace_back(matches.gl_pathv[i]);
-    }
-    globfree(&matches);
-    if (found.empty()) throw InputError("--images: '" + arg + "' matches no file");
-    std::sort(found.begin(), found.end());
-    paths.insert(paths.end(), found.begin(), found.end());
-  }
-  return paths;
 }
 
 // Frames from a source (camera, video, sequence) where the pattern is found, up to opt.frames.

@@ -42,7 +42,7 @@ struct LiveCommandOptions {
   std::string head_start, head_start_offset;
   std::string head_model = "ptu46";
   std::string estimator = "auto";
-  std::string settings;
+  std::string settings, mount;
   double height = -1.0;
   double duration = 0.0;
   bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
@@ -100,9 +100,14 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   if (!ParseHeadModel(opt.head_model, &plan.head_model)) {
     throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
   }
-  CheckHeight(opt.height, "--height");
-  CheckRange(opt.height, 0.05, 100.0, "--height");
-  plan.height = opt.height;
+  if (opt.height < 0.0 && (opt.mount.empty() || plan.sim)) {
+    throw InputError("--height: needed (the camera height above the floor with the head level)");
+  }
+  if (opt.height >= 0.0) {
+    CheckHeight(opt.height, "--height");
+    CheckRange(opt.height, 0.05, 100.0, "--height");
+    plan.height = opt.height;
+  }
   if (!opt.prior.empty() && !opt.prior_file.empty()) {
     throw InputError("--prior and --prior-file: give one of them");
   }
@@ -130,7 +135,6 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   }
   if (opt.snapshot_every < 0) throw InputError("--snapshot-every: must be >= 0");
   CheckRange(opt.max_rate_deg, 0.1, 360.0, "--max-rate");
-  plan.loop.servo.model = plan.head_model;
   plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
   plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
   CheckRange(plan.duration, 0.0, 1e7, "--duration");
@@ -209,6 +213,8 @@ class LiveFiles {
     inputs_.camera = camera_;
     inputs_.model = &model_;
     if (!opt.prior_file.empty()) inputs_.priors = ReadPriors(opt.prior_file);
+    if (!opt.mount.empty()) inputs_.mount = ReadMountFile(opt.mount);
+    inputs_.mount_path = opt.mount;
     if (!opt.prior_file.empty() && inputs_.priors.empty()) {
       throw InputError(opt.prior_file + ": no prior rows");
     }
@@ -352,6 +358,7 @@ nlohmann::ordered_json RunSummaryJson(const LiveRunEnd& end, LiveSession& sessio
   json["source"] = session.DescribeSource();
   json["head"] = session.DescribeHead();
   json["estimator"] = session.DescribeEstimator();
+  json["mount"] = session.DescribeMount();
   LiveLoop& loop = session.loop();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
@@ -393,8 +400,12 @@ void AddLive(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--camera", opt->camera_path,
                   "Camera file: ViSP XML, OpenCV or ROS YAML (with its image size)")
       ->required();
-  cmd->add_option("--height", opt->height, "Camera height above the floor, head level (metres)")
-      ->required();
+  cmd->add_option("--height", opt->height,
+                  "Camera height above the floor, head level (metres; with a --mount that has a "
+                  "floor calibration it may be left out)");
+  cmd->add_option("--mount", opt->mount,
+                  "mount.json of linetrack calibrate-mount: the calibrated camera mount (and its "
+                  "floor height) instead of --head-model's nominal geometry (and --height)");
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option(
       "--prior", opt->prior,

@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/head_mount.h"
 #include "app/integrity_output.h"
 #include "app/line_flags.h"
 #include "app/localize_image.h"
@@ -37,6 +38,7 @@ using Clock = std::chrono::steady_clock;
 
 struct ReplayOptions {
   std::string input, model, camera, prior_file, prior, init_pose, settings, ground_truth, out;
+  std::string mount;  // calibrated camera mount: the prior's tilt is the head's
   double height = 0.0, tilt_deg = 0.0;
   bool has_height = false, has_tilt = false;  // --height, --tilt given
   double delta_t = SearchBounds().delta_t;
@@ -108,6 +110,7 @@ struct ReplaySetup {
   std::optional<Eigen::Isometry3d> start_pose;
   std::optional<Pose3Dof> initial_prior;
   bool robot = false;
+  std::optional<BelievedHead> head;  // --mount
   std::unique_ptr<GroundTruth> ground_truth;
   std::unique_ptr<VideoSource> video;
   std::unique_ptr<Recording> recording;
@@ -227,7 +230,8 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
     throw InputError("replay: give either --prior-file or --prior, not both");
   }
   const bool has_height_tilt = opt.has_height || opt.has_tilt;
-  if ((has_prior || has_height_tilt) && !(opt.has_height && opt.has_tilt)) {
+  const bool height_known = opt.has_height || !opt.mount.empty();  // or the mount's floor
+  if ((has_prior || has_height_tilt) && !(height_known && opt.has_tilt)) {
     throw InputError(has_prior ? "replay: --prior needs both --height and --tilt"
                                : "replay: --height and --tilt go together");
   }
@@ -235,7 +239,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
     throw InputError("replay: nothing to start from: give --init-pose, --prior-file or --prior");
   }
   if (has_height_tilt) {
-    CheckHeight(opt.height, "--height");
+    if (opt.has_height || opt.mount.empty()) CheckHeight(opt.height, "--height");
     CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   }
   CheckRange(opt.delta_t, 0.0, 100.0, "--delta-t");
@@ -246,6 +250,10 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
   s.camera = LoadCamera(opt.camera);
+  if (!opt.mount.empty()) {
+    s.head = BelieveHead(HeadModel::kPtu46, ReadMountFile(opt.mount), opt.mount,
+                         opt.has_height ? std::optional<double>(opt.height) : std::nullopt);
+  }
   s.settings = ReadSettings(opt);
   if (!opt.prior_file.empty()) s.priors = ReadPriors(opt.prior_file);
   if (!opt.init_pose.empty()) s.start_pose = ReadPoseFile(opt.init_pose);
@@ -283,11 +291,12 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
     reading.odometry = prior->Planar();
     reading.height = prior->height;
     reading.tilt = prior->tilt;
-    return reading;
+  } else {
+    reading.height = opt.height;
+    reading.tilt = DegToRad(opt.tilt_deg);
   }
-  reading.height = opt.height;
-  reading.tilt = DegToRad(opt.tilt_deg);
-  return reading;
+  // With a calibrated mount the tilt is the head's: the camera's height and tilt follow.
+  return s.head ? ReadingOnHead(*s.head, reading, reading.tilt) : reading;
 }
 
 // Prints a progress bar on stderr when it is a terminal, at most ten times a second.
@@ -571,6 +580,10 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
                   "Robot start prior X,Y,HEADING_DEG (with --height, --tilt)");
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
+  cmd->add_option("--mount", opt->mount,
+                  "mount.json of linetrack calibrate-mount: --tilt and the prior file's tilt are "
+                  "the head's, the camera's height and tilt follow from the mount (and its floor "
+                  "height, else --height taped with the head level)");
   cmd->add_option("--delta-t", opt->delta_t, "Position bound of the first prior (metres)")
       ->capture_default_str();
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Heading bound of the first prior (degrees)")

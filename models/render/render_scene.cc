@@ -45,6 +45,13 @@ bool RenderSceneOptions::Check(std::string* why) const {
     *why = "clutter_margin must be in [0, 5) metres";
     return false;
   }
+  for (const RenderSurface& s : extra_surfaces) {
+    if (s.polygon.size() < 3 || !(std::abs(s.normal.norm() - 1.0) < 1e-9) ||
+        !(s.albedo >= 0.0 && s.albedo <= 1.0)) {
+      *why = "an extra surface needs 3 corners, a unit normal and an albedo in [0, 1]";
+      return false;
+    }
+  }
   return true;
 }
 
@@ -110,6 +117,8 @@ RenderScene BuildRenderScene(const WireframeModel& model, const RenderSceneOptio
         FrameDecals(model, group, albedo[group.host_face], options.frame_width, options.seed);
     scene.surfaces.insert(scene.surfaces.end(), decals.begin(), decals.end());
   }
+  scene.surfaces.insert(scene.surfaces.end(), options.extra_surfaces.begin(),
+                        options.extra_surfaces.end());
 
   const int nx = std::max(1, static_cast<int>(std::lround((hi.x() - lo.x()) / kLightSpacing)));
   const int ny = std::max(1, static_cast<int>(std::lround((hi.y() - lo.y()) / kLightSpacing)));

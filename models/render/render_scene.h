@@ -22,6 +22,7 @@ enum class SurfaceKind {
   kWindowPane,  // the region inside a closed loop of lines
   kClutter,     // unmodelled objects: boxes, cabinets, posters
   kPerson,      // people walking through the scene (moving occluders)
+  kBoard,       // a calibration board and its squares (board_surfaces.h)
 };
 
 // One planar surface. Decals are painted onto the coplanar surface already visible (same plane,
@@ -42,6 +43,8 @@ struct RenderSceneOptions {
   double frame_width = 0.07;     // width of door and window frame bands (metres)
   int clutter = 0;               // number of unmodelled objects to place
   double clutter_margin = 0.15;  // free space kept around doors, windows and other clutter (m)
+  // Surfaces added as given after the model's: a calibration board (board_surfaces.h).
+  std::vector<RenderSurface> extra_surfaces;
 
   bool Check(std::string* why) const;
 };

@@ -84,6 +84,39 @@ Eigen::Vector2d UndistortedNormalised(const CameraIntrinsics& camera, double u, 
   return x;
 }
 
+// Pixel rectangle [u0, u1) x [v0, v1) that holds the board's image: the bounding box of its
+// outline's image (64 points per side), grown by a margin; the whole image when part of the
+// outline lies behind the camera. Pixels outside it see only the background.
+cv::Rect BoardImageBounds(const CameraIntrinsics& camera, const Eigen::Isometry3d& cam_from_board,
+                          const Eigen::AlignedBox2d& extent) {
+  constexpr int kPerSide = 64;
+  constexpr int kMarginPx = 3;
+  const cv::Rect whole(0, 0, camera.width, camera.height);
+  double u_lo = 1e300, v_lo = 1e300, u_hi = -1e300, v_hi = -1e300;
+  const int around[] = {0, 1, 3, 2};  // Eigen's corner ids in order around the box
+  for (int side = 0; side < 4; ++side) {
+    const Eigen::Vector2d a =
+        extent.corner(static_cast<Eigen::AlignedBox2d::CornerType>(around[side]));
+    const Eigen::Vector2d b =
+        extent.corner(static_cast<Eigen::AlignedBox2d::CornerType>(around[(side + 1) % 4]));
+    for (int k = 0; k < kPerSide; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / kPerSide);
+      const Eigen::Vector3d q = cam_from_board * Eigen::Vector3d(p.x(), p.y(), 0.0);
+      if (!(q.z() > 0.0)) return whole;
+      const Eigen::Vector2d uv = camera.Distort(camera.Project(q));
+      u_lo = std::min(u_lo, uv.x());
+      u_hi = std::max(u_hi, uv.x());
+      v_lo = std::min(v_lo, uv.y());
+      v_hi = std::max(v_hi, uv.y());
+    }
+  }
+  const cv::Rect box(static_cast<int>(std::floor(u_lo)) - kMarginPx,
+                     static_cast<int>(std::floor(v_lo)) - kMarginPx,
+                     static_cast<int>(std::ceil(u_hi - u_lo)) + 2 * kMarginPx + 1,
+                     static_cast<int>(std::ceil(v_hi - v_lo)) + 2 * kMarginPx + 1);
+  return box & whole;
+}
+
 double Uniform(std::mt19937_64& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
@@ -122,10 +155,11 @@ cv::Mat RenderBoard(const PatternSpec& pattern, const CameraIntrinsics& camera,
   h.col(2) = cam_from_board.translation();
   const Eigen::Matrix3d board_from_ray = h.inverse();
   const int n = options.supersampling;
-  cv::Mat image(camera.height, camera.width, CV_64F);
-  for (int v = 0; v < camera.height; ++v) {
+  cv::Mat image(camera.height, camera.width, CV_64F, cv::Scalar(options.background));
+  const cv::Rect bounds = BoardImageBounds(camera, cam_from_board, BoardExtent(pattern, options));
+  for (int v = bounds.y; v < bounds.y + bounds.height; ++v) {
     double* row = image.ptr<double>(v);
-    for (int u = 0; u < camera.width; ++u) {
+    for (int u = bounds.x; u < bounds.x + bounds.width; ++u) {
       double sum = 0.0;
       for (int a = 0; a < n; ++a) {
         for (int b = 0; b < n; ++b) {

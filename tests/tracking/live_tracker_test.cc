@@ -70,7 +70,8 @@ TrackedRun RunWithTracker(const SimCameraOptions& camera, const LiveLoopOptions&
   SimHeadStart start;
   start.offset_from_target = start_offset;
   SimulatedLiveRig rig(TheHall().model, &TheHall().area, TheHall().camera,
-                       SimulatedLiveRigOptions{camera, SimulatedHeadOptions{}, loop, start, {}},
+                       SimulatedLiveRigOptions{
+                           camera, SimulatedHeadOptions{}, NominalBelief(camera, loop), start, {}},
                        tracker.get());
   TrackedRun run;
   for (int k = 0; k < frames; ++k) {

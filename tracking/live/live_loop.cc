@@ -74,7 +74,7 @@ LiveLoop::LiveLoop(LiveLoopParts parts, const WireframeModel& model, const Camer
       occlusion_(model),
       camera_(camera),
       options_(options),
-      geometry_(GeometryOf(options.servo.model)),
+      geometry_(options.servo.geometry),
       limits_(head_->Limits()),
       servo_(options.servo),
       target_(options.target) {

@@ -34,7 +34,7 @@ std::optional<Eigen::Vector3d> VisibleModelCentroid(const WireframeModel& model,
                                                     const CameraIntrinsics& camera);
 
 struct LiveLoopOptions {
-  HeadServoOptions servo;  // its head model is also the geometry of the camera prior
+  HeadServoOptions servo;  // its geometry is also that of the camera prior
   // The servo's target in the world (metres); empty: the centroid of the visible model in the
   // first pose, fixed from then on.
   std::optional<Eigen::Vector3d> target;

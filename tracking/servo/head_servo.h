@@ -16,7 +16,9 @@
 namespace linetrack {
 
 struct HeadServoOptions {
-  HeadModel model = HeadModel::kPtu46;
+  // The camera on the head as the robot believes it: a head's nominal geometry (GeometryOf) or a
+  // calibrated mount. It gives the servo's cVe and eJe.
+  HeadGeometry geometry = GeometryOf(HeadModel::kPtu46);
   // vpAdaptiveGain: lambda(x) = (l0 - linf) exp(-slope x / (l0 - linf)) + linf, x = the joint
   // correction |J^+ e|_inf in radians (1/s; slope 1/(s rad)).
   double gain_at_zero = 8.0;

@@ -22,6 +22,10 @@ struct SimHeadStart {
   std::optional<Eigen::Vector2d> offset_from_target;
 };
 
+// `loop` believing the nominal geometry of the simulated head model and the crossing height that
+// geometry gives for the simulated camera's height (a height taped with the head level).
+LiveLoopOptions NominalBelief(const SimCameraOptions& camera, LiveLoopOptions loop);
+
 // The settings of the rig's parts.
 struct SimulatedLiveRigOptions {
   SimCameraOptions camera;
@@ -34,7 +38,8 @@ struct SimulatedLiveRigOptions {
 class SimulatedLiveRig {
  public:
   // `camera` is the camera of the frames (its undistorted model serves the loop); `model` and
-  // `area` must outlive the rig. The loop's crossing height is taken from the simulated camera.
+  // `area` must outlive the rig. The loop believes options.loop (the servo's geometry and the
+  // crossing height, e.g. NominalBelief), whatever the simulated camera's truth.
   // `estimator` gives the poses (not owned; e.g. the tracker); null: the simulator's truth,
   // jittered by options.jitter. Throws InputError on invalid options, or when an offset start is
   // asked without a target or the target cannot be looked at.
