@@ -1,5 +1,6 @@
 #include "models/wireframe.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -7,6 +8,8 @@
 #include <utility>
 
 #include "models/errors.h"
+#include "models/face_orientation.h"
+#include "models/free_space.h"
 
 namespace linetrack {
 namespace {
@@ -61,6 +64,41 @@ Eigen::Vector3d NewellNormal(const std::vector<Eigen::Vector3d>& corners) {
   return n;
 }
 
+// The faces of `cao` on the merged vertices, with their planes; counts those without area.
+std::vector<ModelFace> BuildFaces(const CaoModel& cao, const std::vector<int>& vertex_of_point,
+                                  const std::vector<Eigen::Vector3d>& vertices, int* degenerate) {
+  std::vector<ModelFace> faces;
+  for (const std::vector<int>& points : cao.faces) {
+    ModelFace face;
+    for (int p : points) {
+      face.vertices.push_back(vertex_of_point[p]);
+      face.corners.push_back(vertices[vertex_of_point[p]]);
+    }
+    const Eigen::Vector3d n = NewellNormal(face.corners);
+    double extent = 0.0;
+    for (const Eigen::Vector3d& c : face.corners)
+      extent = std::max(extent, (c - face.corners[0]).norm());
+    if (n.norm() > 1e-9 * std::max(1.0, extent * extent)) {
+      face.normal = n.normalized();
+      face.offset = face.normal.dot(face.corners[0]);
+      face.vertical = std::abs(face.normal.z()) < 1e-6;
+      face.horizontal = std::abs(std::abs(face.normal.z()) - 1.0) < 1e-9;
+    } else {
+      ++*degenerate;
+    }
+    faces.push_back(std::move(face));
+  }
+  return faces;
+}
+
+void Flip(ModelFace* face) {
+  std::reverse(face->vertices.begin(), face->vertices.end());
+  std::reverse(face->corners.begin(), face->corners.end());
+  face->normal = -face->normal;
+  face->offset = -face->offset;
+  face->flipped = !face->flipped;
+}
+
 }  // namespace
 
 bool WireframeOptions::Check(std::string* why) const {
@@ -97,11 +135,26 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     }
   }
 
+  int degenerate_faces = 0;
+  model.faces_ = BuildFaces(cao, vertex_of_point, model.vertices_, &degenerate_faces);
+  model.storeys_ = DetectStoreys(model.faces_, model.box_min_.z(), model.box_max_.z());
+  if (options.orient_faces) {
+    const std::vector<FaceOrientation> orientation = OrientFaces(model);
+    model.oriented_ = !orientation.empty();
+    for (size_t f = 0; f < orientation.size(); ++f) {
+      if (orientation[f].flip) Flip(&model.faces_[f]);
+      model.faces_[f].two_sided = orientation[f].rule == OrientationRule::kTwoSided;
+      model.faces_[f].one_sided = orientation[f].rule == OrientationRule::kFreeSide ||
+                                  orientation[f].rule == OrientationRule::kOutsideSide;
+    }
+    model.orientation_summary_ = OrientationSummary(model, orientation);
+  }
+
+  // Edges after orientation: a face's edges are numbered in its (oriented) point order.
   const double cos_vertical = std::cos(DegToRad(options.vertical_tolerance_deg));
   std::map<std::pair<int, int>, int> edge_of_vertices;
   int degenerate = 0;
-  auto add_edge = [&](int p0, int p1, bool from_line, int face) {
-    const int v0 = vertex_of_point[p0], v1 = vertex_of_point[p1];
+  auto add_edge = [&](int v0, int v1, bool from_line, int face) {
     if (v0 == v1) {
       ++degenerate;
       return;
@@ -119,11 +172,10 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     edge_of_vertices[key] = edge.id;
     model.edges_.push_back(edge);
   };
-
   for (const auto& line : cao.lines)
-    add_edge(line[0], line[1], true, -1);
-  for (size_t f = 0; f < cao.faces.size(); ++f) {
-    const std::vector<int>& face = cao.faces[f];
+    add_edge(vertex_of_point[line[0]], vertex_of_point[line[1]], true, -1);
+  for (size_t f = 0; f < model.faces_.size(); ++f) {
+    const std::vector<int>& face = model.faces_[f].vertices;
     for (size_t i = 0; i < face.size(); ++i) {
       add_edge(face[i], face[(i + 1) % face.size()], false, static_cast<int>(f));
     }
@@ -131,28 +183,6 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
   if (degenerate > 0) {
     model.warnings_.push_back(
         Located(model.path_, 0, std::to_string(degenerate) + " zero-length edges skipped"));
-  }
-
-  int degenerate_faces = 0;
-  for (const std::vector<int>& points : cao.faces) {
-    ModelFace face;
-    for (int p : points) {
-      face.vertices.push_back(vertex_of_point[p]);
-      face.corners.push_back(model.vertices_[vertex_of_point[p]]);
-    }
-    const Eigen::Vector3d n = NewellNormal(face.corners);
-    double extent = 0.0;
-    for (const Eigen::Vector3d& c : face.corners)
-      extent = std::max(extent, (c - face.corners[0]).norm());
-    if (n.norm() > 1e-9 * std::max(1.0, extent * extent)) {
-      face.normal = n.normalized();
-      face.offset = face.normal.dot(face.corners[0]);
-      face.vertical = std::abs(face.normal.z()) < 1e-6;
-      face.horizontal = std::abs(std::abs(face.normal.z()) - 1.0) < 1e-9;
-    } else {
-      ++degenerate_faces;
-    }
-    model.faces_.push_back(std::move(face));
   }
   if (degenerate_faces > 0) {
     model.warnings_.push_back(
