@@ -92,8 +92,11 @@ std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double 
 
 std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
                                           double camera_top) {
-  const double z_lo = model.BoxMin().z() + tolerance;
-  const double z_hi = std::max(model.BoxMax().z(), camera_top) - tolerance;
+  return OccludersInBand(model, model.BoxMin().z() + tolerance,
+                         std::max(model.BoxMax().z(), camera_top) - tolerance);
+}
+
+std::vector<Segment2> OccludersInBand(const WireframeModel& model, double z_lo, double z_hi) {
   std::vector<Segment2> pieces;
   if (!(z_hi > z_lo)) return pieces;
   for (const ModelFace& face : model.faces()) {
@@ -259,7 +262,7 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
       if (v.norm() <= kTouch) return range;
-      const double a = WrapAngle(std::atan2(v.y(), v.x()) - reference);
+      const double a = std::atan2(Cross2(centre, v), centre.dot(v));  // from the centre, no wrap
       lo = std::min(lo, a);
       hi = std::max(hi, a);
     }

@@ -20,6 +20,10 @@ namespace linetrack {
 std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
                                           double camera_top);
 
+// Floor-plan segments of the parts of the vertical faces that cover [z_lo, z_hi] (one storey's
+// band of camera heights), collinear touching pieces merged.
+std::vector<Segment2> OccludersInBand(const WireframeModel& model, double z_lo, double z_hi);
+
 // Intervals of s where the polygon `s_z` (points (s, z)) covers the whole band [z_lo, z_hi].
 std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi);
 
