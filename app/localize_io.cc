@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace linetrack::app {
@@ -116,9 +117,26 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
   c.problem.delta_t = FiniteNumber(json, "delta_t");
   c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
   c.problem.height = FiniteNumber(json, "height");
+  if (json.contains("storey")) {
+    if (!json["storey"].is_number_integer() || json["storey"].get<int>() < 0) {
+      throw InputError("key \"storey\" must be an integer >= 0");
+    }
+    c.storey = json["storey"].get<int>();
+  }
+  if (json.contains("floor_z")) c.floor_z = FiniteNumber(json, "floor_z");
   c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
   CheckProblem(c.problem);
   return c;
+}
+
+double CameraZ(const WireframeModel& model, double height, int storey, double floor_z) {
+  if (std::isfinite(floor_z)) return floor_z + height;
+  const int s = std::max(storey, 0);
+  if (s >= static_cast<int>(model.storeys().size())) {
+    throw InputError("storey " + std::to_string(s) + ": " + model.path() + " has " +
+                     std::to_string(model.storeys().size()) + " storeys (0 is the lowest)");
+  }
+  return model.storeys()[s].floor_z + height;
 }
 
 nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
@@ -159,9 +177,7 @@ const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
   auto it = models_.find(model_path);
   if (it != models_.end()) return it->second;
   LoadedModel loaded;
-  loaded.model = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
-  for (const std::string& w : loaded.model->warnings())
-    spdlog::warn("{}", w);
+  loaded.model = std::make_unique<WireframeModel>(LoadModel(model_path));
   try {
     loaded.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*loaded.model));
     loaded.regions = std::make_unique<ViewInvariantRegions>(

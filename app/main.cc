@@ -11,6 +11,7 @@
 #include <opencv2/core/version.hpp>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace {
@@ -38,9 +39,12 @@ int main(int argc, char** argv) {
       "linetrack"};
   cli.set_version_flag("--version", VersionText(), "Print the version and exit");
   cli.require_subcommand(1);
-  cli.fallthrough(false);
+  cli.fallthrough(true);  // --quiet and --strict also after the subcommand
   bool quiet = false;
   cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
+  bool strict = false;
+  cli.add_flag("--strict", strict,
+               "Refuse a model the checks find fault with (exit 2) instead of warning");
 
   app::CommandAction action;
   app::AddModelInfo(cli, &action);
@@ -58,6 +62,8 @@ int main(int argc, char** argv) {
   app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddMakeBuilding(cli, &action);
+  app::AddBenchBuilding(cli, &action);
 
   try {
     cli.parse(argc, argv);
@@ -67,6 +73,7 @@ int main(int argc, char** argv) {
     return app::kExitBadInput;
   }
   if (quiet) spdlog::set_level(spdlog::level::err);
+  app::SetStrictModelChecks(strict);
   try {
     return action ? action() : app::kExitBadInput;
   } catch (const InputError& e) {

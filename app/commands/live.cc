@@ -22,6 +22,7 @@
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
+#include "app/model_loading.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -202,7 +203,7 @@ int RunLive(const LiveCommandOptions& opt) {
   if (inputs.camera.width <= 0) {
     throw InputError(opt.camera_path + ": the camera file gives no image size");
   }
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   for (const std::string& w : model.warnings())
     spdlog::warn("{}", w);
   inputs.model = &model;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "app/commands.h"
@@ -22,6 +23,8 @@ namespace {
 struct LocalizeOptions {
   std::string model_path, camera_path, camera_name, lines_path, prior_text, batch_path;
   double delta_t = 0.0, delta_phi_deg = 0.0, height = 0.0, tilt_deg = 0.0;
+  int storey = -1;
+  double floor_z = std::numeric_limits<double>::quiet_NaN();
   std::string method = "tree";
   bool json = false;
   // From an image (--image) instead of --lines: the line extractor's flags and an overlay.
@@ -75,6 +78,7 @@ int RunBatch(const LocalizeOptions& opt) {
       }
       BatchCase c = ParseBatchCase(json, base_dir);
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
+      c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
       const auto start = std::chrono::steady_clock::now();
       const LocalizationResult result = localizer.Localize(c.problem);
       const double ms = Milliseconds(start);
@@ -123,6 +127,7 @@ int RunSingle(const LocalizeOptions& opt) {
   }
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
+  problem.height = CameraZ(localizer.model(), opt.height, opt.storey, opt.floor_z);
   const auto start = std::chrono::steady_clock::now();
   LocalizationResult result;
   if (problem.lines.empty()) {
@@ -193,6 +198,12 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)");
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
+  cmd->add_option("--storey", opt->storey,
+                  "The storey the camera stands on (0 the lowest, default); --height is above "
+                  "its floor")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--floor-z", opt->floor_z,
+                  "World z of the floor the camera stands on (metres), instead of --storey");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
   cmd->add_flag("--json", opt->json, "Print the result as JSON (the batch format)");
   cmd->add_option("--batch", opt->batch_path,

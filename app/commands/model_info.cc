@@ -85,6 +85,23 @@ nlohmann::json Point(const Eigen::Vector3d& p) {
   return {p.x(), p.y(), p.z()};
 }
 
+int NumHoles(const NavigableArea& area) {
+  int n = 0;
+  for (const AreaPart& part : area.parts())
+    n += static_cast<int>(part.holes.size());
+  return n;
+}
+
+nlohmann::json Storeys(const WireframeModel& model, const NavigableArea& area) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t s = 0; s < model.storeys().size(); ++s) {
+    out.push_back({{"floor_z", model.storeys()[s].floor_z},
+                   {"top_z", model.storeys()[s].top_z},
+                   {"area_m2", area.Area(static_cast<int>(s))}});
+  }
+  return out;
+}
+
 int RunModelInfo(const ModelInfoOptions& opt) {
   WireframeOptions wire_options;
   wire_options.vertical_tolerance_deg = opt.vertical_tolerance_deg;
@@ -119,9 +136,11 @@ int RunModelInfo(const ModelInfoOptions& opt) {
       {"navigable_area",
        {{"source", area.source()},
         {"area_m2", area.Area()},
-        {"outer_vertices", static_cast<int>(area.outer().vertices.size())},
-        {"holes", static_cast<int>(area.holes().size())},
+        {"parts", static_cast<int>(area.parts().size())},
+        {"holes", NumHoles(area)},
         {"clearance_m", area.clearance()}}},
+      {"storeys", Storeys(model, area)},
+      {"orientation", model.orientation_summary()},
       {"view_invariant_regions", regions.size()},
       {"view_invariant_regions_build_ms", build_ms},
       {"warnings", model.warnings()},
@@ -152,9 +171,18 @@ int RunModelInfo(const ModelInfoOptions& opt) {
       << "bounding box (m)       x " << lo.x() << " .. " << hi.x() << ", y " << lo.y() << " .. "
       << hi.y() << ", z " << lo.z() << " .. " << hi.z() << "\n"
       << "navigable area         " << area.Area() << " m2 from " << area.source() << ", "
-      << area.outer().vertices.size() << " vertices, " << area.holes().size()
-      << " obstacles, clearance " << area.clearance() << " m\n"
-      << "view-invariant regions " << regions.size() << " (built in " << build_ms << " ms; "
+      << area.parts().size() << (area.parts().size() == 1 ? " part, " : " parts, ")
+      << NumHoles(area) << " obstacles, clearance " << area.clearance() << " m\n";
+  if (model.storeys().size() > 1) {
+    for (size_t s = 0; s < model.storeys().size(); ++s) {
+      out << "storey " << s << "                floor z " << model.storeys()[s].floor_z
+          << " m, walls to " << model.storeys()[s].top_z << " m, " << area.Area(static_cast<int>(s))
+          << " m2\n";
+    }
+  }
+  for (const std::string& line : model.orientation_summary())
+    out << "orientation            " << line << "\n";
+  out << "view-invariant regions " << regions.size() << " (built in " << build_ms << " ms; "
       << regions.occluders().size() << " occluding wall segments, " << regions.solids().size()
       << " solid obstacles)\n";
   if (opt.queries > 0) {

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/navigable_area.h"
@@ -183,7 +184,7 @@ int RunRender(const RenderCommandOptions& opt) {
   const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   for (const std::string& w : model.warnings())
     spdlog::warn("{}", w);
   std::optional<NavigableArea> area;
