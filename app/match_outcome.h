@@ -9,7 +9,7 @@
 
 #include "matching/localizer.h"
 #include "models/robot_pose.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 

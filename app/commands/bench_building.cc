@@ -1,4 +1,4 @@
-// `linetrack bench building`: the generated office building (models/synthetic_building.h)
+// `linetrack bench building`: the generated office building (models/synth/synthetic_building.h)
 // against each of its rooms modelled alone: the regions' build time and memory, localisation
 // per room under the paper's priors (QI1-3), and the localize median of both.
 #include <sys/resource.h>
@@ -14,10 +14,12 @@
 
 #include "app/commands.h"
 #include "app/match_outcome.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/navigable_area.h"
-#include "models/synthetic_building.h"
-#include "models/synthetic_scenes.h"
+#include "models/statistics.h"
+#include "models/synth/synthetic_building.h"
+#include "models/synth/synthetic_scenes.h"
 #include "models/view_invariant_regions.h"
 
 namespace linetrack::app {
@@ -41,12 +43,6 @@ double MaxRssMb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // kilobytes on Linux
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // A model with its area, regions and localizer.
@@ -77,13 +73,7 @@ int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticS
   const std::vector<SyntheticScene> scenes = GenerateScenes(*setup.model, sampling, o);
   int correct = 0;
   for (const SyntheticScene& scene : scenes) {
-    LocalizationProblem problem;
-    problem.lines = scene.lines;
-    problem.prior = scene.prior;
-    problem.delta_t = scene.delta_t;
-    problem.delta_phi = scene.delta_phi;
-    problem.height = scene.height;
-    problem.tilt = scene.tilt;
+    const LocalizationProblem problem = ProblemOf(scene);
     const Clock::time_point start = Clock::now();
     const LocalizationResult result = setup.localizer->Localize(problem);
     times->push_back(MsSince(start));

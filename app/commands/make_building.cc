@@ -5,7 +5,7 @@
 
 #include "app/commands.h"
 #include "models/cao_writer.h"
-#include "models/synthetic_building.h"
+#include "models/synth/synthetic_building.h"
 
 namespace linetrack::app {
 namespace {

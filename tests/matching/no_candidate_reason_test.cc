@@ -4,7 +4,7 @@
 
 #include "matching/localizer.h"
 #include "models/navigable_area.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 #include "models/view_invariant_regions.h"
 
 namespace linetrack {

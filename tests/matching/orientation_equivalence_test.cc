@@ -5,11 +5,13 @@
 
 #include <random>
 
+#include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/cao_reader.h"
 #include "models/navigable_area.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 #include "models/view_invariant_regions.h"
+#include "tests/support/reversed_faces.h"
 
 namespace linetrack {
 namespace {
@@ -17,16 +19,6 @@ namespace {
 constexpr int kScenes = 40;
 
 const std::string kModels = std::string(LINETRACK_SOURCE_DIR) + "/models";
-
-// Every face reversed when `share` is 1, else a seeded random subset.
-CaoModel Reversed(CaoModel cao, double share, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution pick(share);
-  for (std::vector<int>& face : cao.faces) {
-    if (share >= 1.0 || pick(rng)) std::reverse(face.begin(), face.end());
-  }
-  return cao;
-}
 
 struct Matcher {
   WireframeModel model;
@@ -41,24 +33,13 @@ struct Matcher {
         localizer(model, &regions, &area, PaperSyntheticCamera()) {}
 };
 
-LocalizationProblem ProblemOf(const SyntheticScene& scene) {
-  LocalizationProblem problem;
-  problem.lines = scene.lines;
-  problem.prior = scene.prior;
-  problem.delta_t = scene.delta_t;
-  problem.delta_phi = scene.delta_phi;
-  problem.height = scene.height;
-  problem.tilt = scene.tilt;
-  return problem;
-}
-
 class Equivalence : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(Equivalence, ReversedFacesLocaliseExactlyAsWritten) {
   const CaoModel cao = ReadCao(kModels + "/" + GetParam());
   const Matcher written(cao);
-  const Matcher all_reversed(Reversed(cao, 1.0, 0u));
-  const Matcher half_reversed(Reversed(cao, 0.5, 3u));
+  const Matcher all_reversed(test_support::ReversedFaces(cao, 1.0, 0u));
+  const Matcher half_reversed(test_support::ReversedFaces(cao, 0.5, 3u));
   SyntheticSceneOptions options;
   options.count = kScenes;
   const PriorBounds qi2 = QualityIndexBounds(2);

@@ -1,7 +1,7 @@
 // The generated building: its size, its faces facing the free space as written (and coming back so
 // from reversed), two storeys, a navigable area per storey joining rooms and corridor through the
 // doors, regions that keep each storey to its own edges, and no finding of the model checks.
-#include "models/synthetic_building.h"
+#include "models/synth/synthetic_building.h"
 
 #include <gtest/gtest.h>
 

@@ -12,22 +12,13 @@
 #include "models/cao_writer.h"
 #include "models/free_space.h"
 #include "models/wireframe.h"
+#include "tests/support/reversed_faces.h"
 
 namespace linetrack {
 namespace {
 
 const std::string kModels = std::string(LINETRACK_SOURCE_DIR) + "/models";
 const std::string kVispCube = "/usr/share/visp-images-data/ViSP-images/mbt/cube.cao";
-
-// Reverses the point order of every face when `share` is 1, else of a seeded random subset.
-CaoModel Reversed(CaoModel cao, double share, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution pick(share);
-  for (std::vector<int>& face : cao.faces) {
-    if (share >= 1.0 || pick(rng)) std::reverse(face.begin(), face.end());
-  }
-  return cao;
-}
 
 int CountReversed(const CaoModel& a, const CaoModel& b) {
   int n = 0;
@@ -66,7 +57,7 @@ TEST_P(BundledModel, IsWrittenFacingItsFreeSpace) {
 TEST_P(BundledModel, AllFacesReversedComeBackAsWritten) {
   const CaoModel cao = ReadCao(kModels + "/" + GetParam());
   const WireframeModel original = WireframeModel::FromCao(cao);
-  const CaoModel reversed = Reversed(cao, 1.0, 0u);
+  const CaoModel reversed = test_support::ReversedFaces(cao, 1.0, 0u);
   const WireframeModel turned = WireframeModel::FromCao(reversed);
   ExpectSameModel(original, turned);
   int flipped = 0;
@@ -82,7 +73,7 @@ TEST_P(BundledModel, SeededSubsetsReversedComeBackAsWritten) {
   const WireframeModel original = WireframeModel::FromCao(cao);
   for (unsigned seed = 1; seed <= 5; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    const CaoModel reversed = Reversed(cao, 0.5, seed);
+    const CaoModel reversed = test_support::ReversedFaces(cao, 0.5, seed);
     ASSERT_GT(CountReversed(cao, reversed), 0);
     ExpectSameModel(original, WireframeModel::FromCao(reversed));
   }
@@ -96,7 +87,7 @@ INSTANTIATE_TEST_SUITE_P(Models, BundledModel, ::testing::Values("hall.cao", "ro
 
 TEST(FaceOrientation, HallReversedSaysWhatItTurned) {
   const WireframeModel turned =
-      WireframeModel::FromCao(Reversed(ReadCao(kModels + "/hall.cao"), 1.0, 0u));
+      WireframeModel::FromCao(test_support::ReversedFaces(ReadCao(kModels + "/hall.cao"), 1.0, 0u));
   // Four room walls and the partition's three faces (a wall too thin to stand in), the two
   // pillars' eight faces.
   const std::vector<std::string> expected = {"7 wall faces turned to face the room",
@@ -106,7 +97,7 @@ TEST(FaceOrientation, HallReversedSaysWhatItTurned) {
 
 TEST(FaceOrientation, ObjectSeenFromOutsideIsLeftAsWritten) {
   const CaoModel cao = ReadCao(kVispCube);
-  const WireframeModel cube = WireframeModel::FromCao(Reversed(cao, 1.0, 0u));
+  const WireframeModel cube = WireframeModel::FromCao(test_support::ReversedFaces(cao, 1.0, 0u));
   EXPECT_FALSE(cube.oriented());
   for (const ModelFace& face : cube.faces())
     EXPECT_FALSE(face.flipped);

@@ -12,6 +12,7 @@
 #include "models/navigable_area.h"
 #include "models/render/scene_renderer.h"
 #include "models/render/sequence.h"
+#include "tests/support/reversed_faces.h"
 #include "tracking/tracker/edge_tracker.h"
 
 namespace linetrack {
@@ -24,12 +25,7 @@ const std::string kSource = LINETRACK_SOURCE_DIR;
 // Writes `cao` with every face reversed (`share` 1) or a seeded subset, as a file of the test.
 std::string WriteReversed(const CaoModel& cao, double share, unsigned seed,
                           const std::string& name) {
-  CaoModel reversed = cao;
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution pick(share);
-  for (std::vector<int>& face : reversed.faces) {
-    if (share >= 1.0 || pick(rng)) std::reverse(face.begin(), face.end());
-  }
+  const CaoModel reversed = test_support::ReversedFaces(cao, share, seed);
   const std::string path = ::testing::TempDir() + "linetrack_reversed_" + name;
   std::ofstream(path) << CaoText(reversed, "reversed faces");
   return path;

@@ -1,4 +1,4 @@
-#include "models/synthetic_building.h"
+#include "models/synth/synthetic_building.h"
 
 #include <algorithm>
 #include <array>
