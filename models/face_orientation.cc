@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "models/convex_polygon.h"
 #include "models/occlusion.h"
@@ -40,25 +39,17 @@ int Rank(SpaceKind kind) {
 std::vector<Eigen::Vector3d> VerticalSamples(const ModelFace& face,
                                              const std::vector<Storey>& storeys,
                                              const FreeSpaceOptions& options) {
-  const Eigen::Vector2d n = face.normal.head<2>().normalized();
-  const Eigen::Vector2d along(-n.y(), n.x());
-  const Eigen::Vector2d origin = face.corners.front().head<2>();
-  Ring2 s_z;
-  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
-  for (const Eigen::Vector3d& c : face.corners) {
-    s_z.emplace_back(along.dot(c.head<2>() - origin), c.z());
-    z_lo = std::min(z_lo, c.z());
-    z_hi = std::max(z_hi, c.z());
-  }
+  const WallInPlane wall = ToWallPlane(face);
+  const double z_lo = wall.z_lo, z_hi = wall.z_hi;
   const Storey& st = storeys[StoreyAt(storeys, 0.5 * (z_lo + z_hi))];
   std::vector<Eigen::Vector3d> points;
   for (double z : {NavigationHeight(st, options), st.floor_z + 1.0, 0.5 * (st.floor_z + st.top_z),
                    st.top_z - 0.25, 0.5 * (z_lo + z_hi)}) {
     if (z < z_lo + kEdgeMargin || z > z_hi - kEdgeMargin) continue;
-    for (const auto& [s0, s1] : FullHeightSpans(s_z, z - kBand, z + kBand)) {
+    for (const auto& [s0, s1] : FullHeightSpans(wall.s_z, z - kBand, z + kBand)) {
       if (s1 - s0 < kMinSpan) continue;
       for (double f : {0.25, 0.5, 0.75}) {
-        const Eigen::Vector2d p = origin + (s0 + f * (s1 - s0)) * along;
+        const Eigen::Vector2d p = wall.At(s0 + f * (s1 - s0));
         points.emplace_back(p.x(), p.y(), z);
       }
     }

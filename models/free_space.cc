@@ -211,19 +211,10 @@ PlanSection PlanSection::Build(const WireframeModel& model, double z,
   std::vector<PlanWall> walls;
   for (const ModelFace& face : model.faces()) {
     if (!face.vertical || face.Degenerate()) continue;
-    const Eigen::Vector2d n = face.normal.head<2>().normalized();
-    const Eigen::Vector2d along(-n.y(), n.x());
-    const Eigen::Vector2d origin = face.corners.front().head<2>();
-    Ring2 s_z;
-    double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
-    for (const Eigen::Vector3d& c : face.corners) {
-      s_z.emplace_back(along.dot(c.head<2>() - origin), c.z());
-      z_lo = std::min(z_lo, c.z());
-      z_hi = std::max(z_hi, c.z());
-    }
-    if (z_lo > z - kBand || z_hi < z + kBand) continue;
-    for (const auto& [s0, s1] : FullHeightSpans(s_z, z - kBand, z + kBand)) {
-      const Segment2 span{origin + s0 * along, origin + s1 * along};
+    const WallInPlane wall = ToWallPlane(face);
+    if (wall.z_lo > z - kBand || wall.z_hi < z + kBand) continue;
+    for (const auto& [s0, s1] : FullHeightSpans(wall.s_z, z - kBand, z + kBand)) {
+      const Segment2 span{wall.At(s0), wall.At(s1)};
       section.walls_.push_back(span);
       walls.push_back({span, Eigen::Vector2d::Zero()});
     }
