@@ -125,36 +125,42 @@ ViewCounts CountViews(const ModelFace& face, const std::vector<Eigen::Vector3d>&
   return counts;
 }
 
-// Compares the two sides of the face at every sample; the side ranked higher at more samples wins.
-// Ties between two free sides are left to CountViews.
+// Compares the two sides of the face at every sample. Samples with free space on one side only
+// vote for it; only when there are none do samples between outside and a solid vote (a facade):
+// a room's wall with a cabinet against it has solid in front of it there and outside behind, but
+// free space in front elsewhere. Ties between two free sides are left to CountViews.
 FaceOrientation DecideBySpace(const ModelFace& face, const std::vector<Eigen::Vector3d>& samples,
                               FreeSpace* space, double offset, int* both_free) {
-  int vote = 0;
-  SpaceAt best_front, best_back, behind_front, behind_back;
+  int free_vote = 0, outer_vote = 0;
+  SpaceAt free_front, free_back, outer_front, outer_back;  // what lies behind the winning side
   for (const Eigen::Vector3d& q : samples) {
     const SpaceAt front = space->Classify(q + offset * face.normal);
     const SpaceAt back = space->Classify(q - offset * face.normal);
     const int rf = Rank(front.kind), rb = Rank(back.kind);
+    const bool free_side = front.kind == SpaceKind::kFree || back.kind == SpaceKind::kFree;
+    int* vote = free_side ? &free_vote : &outer_vote;
     if (rf > rb) {
-      ++vote;
-      best_front = front;
-      behind_front = back;
+      ++*vote;
+      (free_side ? free_front : outer_front) = back;
     } else if (rb > rf) {
-      --vote;
-      best_back = back;
-      behind_back = front;
+      --*vote;
+      (free_side ? free_back : outer_back) = front;
     } else if (front.kind == SpaceKind::kFree) {
       ++*both_free;
     }
   }
   FaceOrientation decision;
   decision.rule = OrientationRule::kUndecided;
+  const int vote = free_vote != 0 ? free_vote : outer_vote;
   if (vote == 0) return decision;
   decision.flip = vote < 0;
-  const SpaceAt& faced = decision.flip ? best_back : best_front;
-  decision.behind = decision.flip ? behind_back : behind_front;
-  decision.rule =
-      faced.kind == SpaceKind::kFree ? OrientationRule::kFreeSide : OrientationRule::kOutsideSide;
+  if (free_vote != 0) {
+    decision.rule = OrientationRule::kFreeSide;
+    decision.behind = decision.flip ? free_back : free_front;
+  } else {
+    decision.rule = OrientationRule::kOutsideSide;
+    decision.behind = decision.flip ? outer_back : outer_front;
+  }
   return decision;
 }
 
