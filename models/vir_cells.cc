@@ -140,8 +140,9 @@ std::vector<Segment2> EventRays(const std::vector<Eigen::Vector2d>& points,
   for (size_t c_id = 0; c_id < arrangement.vertices().size(); ++c_id) {
     const Eigen::Vector2d& c = arrangement.vertices()[c_id];
     const std::vector<int>& around = arrangement.Neighbours(static_cast<int>(c_id));
+    // Rays start at the corners of solids and at the free ends of walls (a partition, a jamb).
     if (around.empty() || (c.array() < lo.array()).any() || (c.array() > hi.array()).any() ||
-        !is_corner(c)) {
+        (around.size() > 1 && !is_corner(c))) {
       continue;
     }
     std::vector<double> angles;

@@ -30,9 +30,9 @@ void SplitCells(const Segment2& segment, std::vector<Cell>* cells);
 std::vector<Cell> InitialCells(const std::vector<const AreaPart*>& parts,
                                const SegmentGrid& stoppers, double grid_pitch);
 
-// Event rays (Simsarian et al. 1996): from a vertex c of a solid (`solids`), away from a point v
-// of `points` within `range` metres that c can start to hide (v sees c, and the walls at c lie on
-// one side of the line v-c), up to the next occluder or the box [lo, hi].
+// Event rays (Simsarian et al. 1996): from a vertex c of a solid (`solids`) or a free end of a
+// wall, away from a point v of `points` within `range` metres that c can start to hide (v sees c,
+// and the walls at c lie on one side of the line v-c), up to the next occluder or the box [lo, hi].
 std::vector<Segment2> EventRays(const std::vector<Eigen::Vector2d>& points,
                                 const SegmentGrid& occluders, const std::vector<Ring2>& solids,
                                 const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double range);
