@@ -18,6 +18,7 @@ void AddBenchLines(CLI::App& cli, CommandAction* action);
 void AddLines(CLI::App& cli, CommandAction* action);
 void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action);
 void AddBenchTrack(CLI::App& cli, CommandAction* action);
+void AddBenchDrive(CLI::App& cli, CommandAction* action);
 void AddReplay(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);

@@ -58,9 +58,10 @@ LiveSession::LiveSession(const LivePlan& plan, const LiveInputs& inputs) {
       if (!head.Check(&why)) throw InputError("--head-start: " + why);
     }
     start.offset_from_target = plan.head_start_offset;
-    rig_ = std::make_unique<SimulatedLiveRig>(*inputs.model, inputs.area, inputs.camera,
-                                              plan.sim_camera, head, plan.loop, start,
-                                              PoseJitterOptions{}, tracker_.get());
+    rig_ = std::make_unique<SimulatedLiveRig>(
+        *inputs.model, inputs.area, inputs.camera,
+        SimulatedLiveRigOptions{plan.sim_camera, head, plan.loop, start, PoseJitterOptions{}},
+        tracker_.get());
     return;
   }
   OpenDevices(plan, inputs);
@@ -102,8 +103,9 @@ void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
   }
   LiveLoopOptions options = plan.loop;
   options.crossing_height = crossing;
-  loop_ = std::make_unique<LiveLoop>(source_.get(), head_.get(), tracker_.get(), odometry,
-                                     *inputs.model, inputs.camera.Undistorted(), options);
+  loop_ = std::make_unique<LiveLoop>(
+      LiveLoopParts{source_.get(), head_.get(), tracker_.get(), odometry}, *inputs.model,
+      inputs.camera.Undistorted(), options);
 }
 
 LiveSession::~LiveSession() = default;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/cli_common.h"
 #include "app/model_loading.h"
 #include "models/errors.h"
 
@@ -84,9 +85,7 @@ std::vector<Segment2> ReadLinesCsv(const std::string& path) {
 BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir) {
   if (!json.is_object()) throw InputError("a case must be a JSON object");
   BatchCase c;
-  c.id = json.contains("id") && json["id"].is_string() ? json["id"].get<std::string>()
-         : json.contains("id")                         ? json["id"].dump()
-                                                       : "";
+  if (json.contains("id")) c.id = json["id"];
   c.model_path = Resolve(Required<std::string>(json, "model"), base_dir);
   c.camera_path = Resolve(Required<std::string>(json, "camera"), base_dir);
   if (json.contains("camera_name")) c.camera_name = Required<std::string>(json, "camera_name");
@@ -117,6 +116,9 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
   c.problem.delta_t = FiniteNumber(json, "delta_t");
   c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
   c.problem.height = FiniteNumber(json, "height");
+  if (c.problem.height <= 0.0) {
+    throw InputError("key \"height\" is not a camera height (metres above the floor, > 0)");
+  }
   if (json.contains("storey")) {
     if (!json["storey"].is_number_integer() || json["storey"].get<int>() < 0) {
       throw InputError("key \"storey\" must be an integer >= 0");
@@ -139,8 +141,8 @@ double CameraZ(const WireframeModel& model, double height, int storey, double fl
   return model.storeys()[s].floor_z + height;
 }
 
-nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
-                                    double time_ms) {
+nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const LocalizationResult& result,
+                                    double time_ms, const WireframeModel* model) {
   nlohmann::ordered_json out;
   out["id"] = id;
   out["found"] = result.found;
@@ -166,6 +168,12 @@ nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationRes
   for (const auto& [edge, line] : result.matches)
     matches.push_back({edge, line});
   out["matches"] = matches;
+  if (model) {
+    nlohmann::ordered_json names = nlohmann::ordered_json::array();
+    for (const auto& match : result.matches)
+      names.push_back(model->edges().at(static_cast<size_t>(match.first)).name);
+    out["edge_names"] = names;
+  }
   out["hypotheses"] = result.hypotheses;
   out["candidate_edges"] = result.candidate_edges;
   out["tree_nodes"] = result.tree_nodes;
@@ -198,7 +206,7 @@ const Localizer& LocalizerCache::Get(const std::string& model_path, const std::s
   const std::string camera_key = camera_path + "\n" + camera_name;
   auto cam = cameras_.find(camera_key);
   if (cam == cameras_.end()) {
-    cam = cameras_.emplace(camera_key, ReadCameraXml(camera_path, camera_name)).first;
+    cam = cameras_.emplace(camera_key, LoadCamera(camera_path, camera_name)).first;
   }
   if (cam->second.width <= 0) {
     throw InputError(Located(camera_path, 0, "the camera file gives no image size"));

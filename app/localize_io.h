@@ -20,7 +20,7 @@ std::vector<Segment2> ReadLinesCsv(const std::string& path);
 
 // One case of a batch file (see docs/matching.md for the format).
 struct BatchCase {
-  std::string id;
+  nlohmann::json id;       // the case's "id" as given (a string, a number...); null without one
   std::string model_path;  // resolved against the batch file's folder
   std::string camera_path;
   std::string camera_name;  // optional "camera_name" key
@@ -39,10 +39,11 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
 // above `floor_z` when finite. Throws InputError when the storey does not exist.
 double CameraZ(const WireframeModel& model, double height, int storey, double floor_z);
 
-// The result of one case as a JSON object: id, found, pose, cMo, matches, score, hypotheses,
-// time_ms (and diagnostics: candidate_edges, tree_nodes, reason).
-nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
-                                    double time_ms);
+// The result of one case as a JSON object: id (as given), found, pose, cMo, matches ([edge,
+// line] pairs), score, hypotheses, time_ms (and diagnostics: candidate_edges, tree_nodes,
+// reason); with `model`, also edge_names: the name of each match's edge ("" when unnamed).
+nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const LocalizationResult& result,
+                                    double time_ms, const WireframeModel* model = nullptr);
 
 // A model with what localisation needs beside it: navigable area (when derivable) and
 // view-invariant regions.

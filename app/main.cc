@@ -39,7 +39,9 @@ int main(int argc, char** argv) {
       "linetrack"};
   cli.set_version_flag("--version", VersionText(), "Print the version and exit");
   cli.require_subcommand(1);
-  cli.fallthrough(true);  // --quiet and --strict also after the subcommand
+  // Global flags (--quiet, --strict) are accepted after the subcommand too: its subcommands
+  // (inheriting this) hand the options they do not know up to here.
+  cli.fallthrough(true);
   bool quiet = false;
   cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
   bool strict = false;
@@ -59,6 +61,7 @@ int main(int argc, char** argv) {
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
+  app::AddBenchDrive(cli, &action);
   app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);

@@ -38,7 +38,7 @@ struct PatternDetection {
 
 // The cornerSubPix half window used for a board whose nearest corners are `min_spacing_px`
 // apart: the configured one, shrunk to round(spacing / 2) (at least 2) so that the window never
-// takes in the neighbouring corners (an 11 px half window on 14 px squares errs by up to 6 px).
+// takes in the neighbouring corners, which would pull the corner off by pixels.
 int SubpixHalfWindow(int configured, double min_spacing_px);
 
 // Detects `pattern` in an 8-bit grey image. Throws cv::Exception only on OpenCV faults.

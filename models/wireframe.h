@@ -32,6 +32,9 @@ struct ModelEdge {
   bool vertical = false;
   bool from_line = false;  // true: a 3D line of the file; false: first seen as a face edge
   int face = -1;           // first face the edge belongs to, -1 for a free 3D line
+  // The name="..." of its 3D line; else the names of the named faces it borders, joined by '/'
+  // ("wall_south/wall_east"); "" when none is named.
+  std::string name;
 };
 
 // A planar face (polygon) of the model. The normal follows ViSP's convention: the right-hand rule
@@ -48,6 +51,7 @@ struct ModelFace {
   bool two_sided = false;  // free space on both sides, seen from both
   // Free space in front only (a room's wall, a pillar's side, a facade): no camera sees its back.
   bool one_sided = false;
+  std::string name;  // its name="..." in the file ("" without)
 
   bool Degenerate() const { return normal.isZero(); }
 };

@@ -108,8 +108,10 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d(options.start_pan_offset, options.start_tilt_offset);
     const auto tracker = MakeTracker();
-    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter, tracker.get());
+    SimulatedLiveRig rig(
+        model, &area, camera,
+        SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, loop, start, options.jitter},
+        tracker.get());
     runs.push_back(RunOne("still", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.still_seconds * options.fps)),
                           options.still_seconds / 2));
@@ -120,8 +122,10 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d::Zero();
     const auto tracker = MakeTracker();
-    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter, tracker.get());
+    SimulatedLiveRig rig(
+        model, &area, camera,
+        SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, loop, start, options.jitter},
+        tracker.get());
     runs.push_back(RunOne("drive", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.drive_seconds * options.fps)),
                           options.settle_seconds));

@@ -253,6 +253,15 @@ void AddCalibrationFlags(CLI::App* cmd, CalibrateCommandOptions* opt) {
   cmd->add_flag("--fix-k3", opt->calib.opencv.fix_k3, "OpenCV model: k3 = 0 (CALIB_FIX_K3)");
 }
 
+// Refuses the pattern and rejection flags that the chosen pattern or --keep-all leave unused.
+void RefuseUnusedCalibrationFlags(const CLI::App& cmd, const CalibrateCommandOptions& opt) {
+  RefuseUnless(cmd, opt.pattern == "charuco", {"--marker", "--dictionary"},
+               "applies to --pattern charuco");
+  RefuseUnless(cmd, opt.pattern == "chessboard", {"--sb"}, "applies to --pattern chessboard");
+  RefuseUnless(cmd, !opt.keep_all, {"--outlier-factor", "--outlier-min-error"},
+               "not with --keep-all (no view is rejected as an outlier)");
+}
+
 }  // namespace
 
 void AddCalibrate(CLI::App& cli, CommandAction* action) {
@@ -274,7 +283,12 @@ void AddCalibrate(CLI::App& cli, CommandAction* action) {
       ->required();
   cmd->add_option("--name", opt->camera_name, "Camera name in the XML and ROS files")
       ->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunCalibrate(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnusedCalibrationFlags(*cmd, *opt);
+    RefuseUnless(*cmd, !opt->source.empty(), {"--frames", "--max-grabs"},
+                 "applies to --source (frames grabbed until the pattern is seen)");
+    *action = [opt] { return RunCalibrate(*opt); };
+  });
 }
 
 void AddBenchCalibrate(CLI::App& cli, CommandAction* action) {
@@ -283,7 +297,10 @@ void AddBenchCalibrate(CLI::App& cli, CommandAction* action) {
       "calibrate", "Time of a whole calibration (detection + estimation), median of --repeat runs");
   AddCalibrationFlags(cmd, opt.get());
   cmd->add_option("--repeat", opt->repeat, "Runs")->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunBenchCalibrate(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnusedCalibrationFlags(*cmd, *opt);
+    *action = [opt] { return RunBenchCalibrate(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -17,13 +17,17 @@
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
+#include "tracking/tracker/relocalizer.h"
 
 namespace linetrack::app {
 namespace {
 
 struct LocalizeOptions {
   std::string model_path, camera_path, camera_name, lines_path, prior_text, batch_path;
-  double delta_t = 0.0, delta_phi_deg = 0.0, height = 0.0, tilt_deg = 0.0;
+  // The prior's bounds default to those of `replay`'s first prior (the paper's QI3).
+  double delta_t = SearchBounds().delta_t;
+  double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
+  double height = 0.0, tilt_deg = 0.0;
   int storey = -1;
   double floor_z = std::numeric_limits<double>::quiet_NaN();
   std::string method = "tree";
@@ -74,12 +78,10 @@ int RunBatch(const LocalizeOptions& opt) {
     ++number;
     if (row.find_first_not_of(" \t\r") == std::string::npos) continue;
     ++cases;
-    std::string id = "line-" + std::to_string(number);
+    nlohmann::json id = "line-" + std::to_string(number);  // a case without an id: its line
     try {
       const nlohmann::json json = nlohmann::json::parse(row);
-      if (json.is_object() && json.contains("id")) {
-        id = json["id"].is_string() ? json["id"].get<std::string>() : json["id"].dump();
-      }
+      if (json.is_object() && json.contains("id")) id = json["id"];
       BatchCase c = ParseBatchCase(json, base_dir);
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
       c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
@@ -87,7 +89,8 @@ int RunBatch(const LocalizeOptions& opt) {
       const LocalizationResult result = localizer.Localize(c.problem);
       const double ms = Milliseconds(start);
       found += result.found ? 1 : 0;
-      std::cout << ResultToJson(id, result, ms).dump() << "\n";
+      std::cout << ResultToJson(id, result, ms, cache.Model(c.model_path).model.get()).dump()
+                << "\n";
     } catch (const nlohmann::json::parse_error&) {
       std::cout << nlohmann::ordered_json{{"id", id},
                                           {"found", false},
@@ -108,7 +111,29 @@ int RunBatch(const LocalizeOptions& opt) {
   return kExitOk;
 }
 
+// The result as text: the pose and each match with its edge's name, or why there is none.
+void PrintResult(const LocalizationResult& result, const WireframeModel& model, double ms) {
+  if (result.found) {
+    std::cout << std::fixed << std::setprecision(3) << "pose      x " << result.pose.x << " m, y "
+              << result.pose.y << " m, heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading)) << " deg\n"
+              << "matches   " << result.matches.size() << " (model edge <- image line)\n";
+    for (const auto& [e, l] : result.matches) {
+      const std::string& name = model.edges().at(static_cast<size_t>(e)).name;
+      std::cout << "          edge " << e << (name.empty() ? "" : " " + name) << " <- line " << l
+                << "\n";
+    }
+    std::cout << "score     " << result.score_px << " px, support " << result.support
+              << "\nsearch    " << result.candidate_edges << " candidate edges, "
+              << result.hypotheses << " hypotheses, " << ms << " ms\n";
+  } else {
+    std::cout << "no pose: " << result.reason << " (" << result.hypotheses << " hypotheses, "
+              << std::fixed << std::setprecision(2) << ms << " ms)\n";
+  }
+}
+
 int RunSingle(const LocalizeOptions& opt) {
+  CheckHeight(opt.height, "--height");
   LocalizationProblem problem;
   problem.prior = ParsePrior(opt.prior_text, "--prior");
   problem.delta_t = opt.delta_t;
@@ -150,26 +175,15 @@ int RunSingle(const LocalizeOptions& opt) {
               << std::fixed << std::setprecision(2) << image->ms << " ms)\n";
   }
   if (opt.json) {
-    nlohmann::ordered_json json =
-        ResultToJson(std::filesystem::path(source).stem().string(), result, ms);
+    nlohmann::ordered_json json = ResultToJson(std::filesystem::path(source).stem().string(),
+                                               result, ms, cache.Model(opt.model_path).model.get());
     if (image) {
       json["lines"] = image->segments.size();
       json["lines_ms"] = image->ms;
     }
     std::cout << json.dump(2) << std::endl;
-  } else if (result.found) {
-    std::cout << std::fixed << std::setprecision(3) << "pose      x " << result.pose.x << " m, y "
-              << result.pose.y << " m, heading " << std::setprecision(2)
-              << RadToDeg(WrapAngle(result.pose.heading)) << " deg\n"
-              << "matches   " << result.matches.size() << " (edge:line";
-    for (const auto& [e, l] : result.matches)
-      std::cout << " " << e << ":" << l;
-    std::cout << ")\nscore     " << result.score_px << " px, support " << result.support
-              << "\nsearch    " << result.candidate_edges << " candidate edges, "
-              << result.hypotheses << " hypotheses, " << ms << " ms\n";
   } else {
-    std::cout << "no pose: " << result.reason << " (" << result.hypotheses << " hypotheses, "
-              << std::fixed << std::setprecision(2) << ms << " ms)\n";
+    PrintResult(result, *cache.Model(opt.model_path).model, ms);
   }
   return result.found ? kExitOk : kExitJobFailed;
 }
@@ -183,7 +197,8 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       "Camera pose from image line segments against a .cao model, from a rough prior "
       "(interpretation-tree matcher after Ait Aider et al. 2005)");
   cmd->add_option("--model", opt->model_path, "ViSP .cao model");
-  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML (undistorted pixels)");
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (undistorted pixels)");
   cmd->add_option("--camera-name", opt->camera_name, "Camera name in the XML (default: first)");
   cmd->add_option("--lines", opt->lines_path, "CSV of segments u1,v1,u2,v2 in pixels");
   cmd->add_option("--image", opt->image_path,
@@ -199,8 +214,10 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
                   "Relative focal-length uncertainty of the camera file")
       ->capture_default_str();
   cmd->add_option("--prior", opt->prior_text, "Prior pose X,Y,HEADING_DEG (metres, degrees)");
-  cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)");
-  cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
+  cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)")
+      ->capture_default_str();
+  cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)")
+      ->capture_default_str();
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
   cmd->add_option("--storey", opt->storey,
                   "The storey the camera stands on (0 the lowest, default); --height is above "
@@ -215,21 +232,24 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--method", opt->method, "tree (default) or baseline (hypothesise-and-test)")
       ->check(CLI::IsMember({"tree", "baseline"}));
   cmd->callback([opt, action, cmd] {
-    if (!opt->batch_path.empty()) {
+    const bool batch = !opt->batch_path.empty();
+    RefuseUnless(
+        *cmd, !batch,
+        {"--model", "--camera", "--camera-name", "--lines", "--image", "--overlay", "--prior",
+         "--delta-t", "--delta-phi", "--height", "--storey", "--floor-z", "--tilt", "--json"},
+        "not with --batch (each case of the batch gives its own)");
+    RefuseUnless(*cmd, cmd->count("--image") > 0,
+                 {"--overlay", "--detector", "--min-length", "--roi", "--no-merge", "--undistort"},
+                 "applies to the lines extracted from an --image");
+    if (batch) {
       *action = [opt] { return RunBatch(*opt); };
       return;
     }
-    for (const char* flag :
-         {"--model", "--camera", "--prior", "--delta-t", "--delta-phi", "--height", "--tilt"}) {
-      if (cmd->count(flag) == 0) {
-        throw CLI::RequiredError(std::string(flag) + " is required without --batch");
-      }
+    for (const char* flag : {"--model", "--camera", "--prior", "--height", "--tilt"}) {
+      if (cmd->count(flag) == 0) throw CLI::ValidationError(flag, "required without --batch");
     }
     if (cmd->count("--lines") + cmd->count("--image") != 1) {
-      throw CLI::RequiredError("give one of --lines and --image (without --batch)");
-    }
-    if (cmd->count("--overlay") > 0 && cmd->count("--image") == 0) {
-      throw CLI::ValidationError("--overlay", "draws over an --image");
+      throw CLI::ValidationError("--lines, --image", "give one of them (without --batch)");
     }
     *action = [opt] { return RunSingle(*opt); };
   });

@@ -29,6 +29,7 @@ struct ModelInfoOptions {
   double clearance = NavigableAreaOptions().clearance;
   double vertical_tolerance_deg = WireframeOptions().vertical_tolerance_deg;
   bool json = false;
+  bool edges = false;  // list every edge with its name and end points
   // Benchmark of the VIR query: random priors in the navigable area (0: none).
   int queries = 0;
   double query_radius = 0.5;       // delta_t, metres (the paper's QI2)
@@ -157,6 +158,49 @@ std::string ModelTable(const WireframeModel& model, const NavigableArea& area,
   return out.str();
 }
 
+// Every edge: id, name, end points (metres) and whether it is vertical.
+nlohmann::json EdgeListJson(const WireframeModel& model) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const ModelEdge& e : model.edges()) {
+    list.push_back({{"id", e.id},
+                    {"name", e.name},
+                    {"from", Point(e.segment.a)},
+                    {"to", Point(e.segment.b)},
+                    {"vertical", e.vertical}});
+  }
+  return list;
+}
+
+// "(x, y, z)" in metres, two decimals.
+std::string PointText(const Eigen::Vector3d& p) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(2) << "(" << p.x() << ", " << p.y() << ", " << p.z()
+       << ")";
+  return text.str();
+}
+
+// The same as a table, one edge a line: id, name ("-" without one), end points, "vertical".
+std::string EdgeListText(const WireframeModel& model) {
+  size_t width = 4;
+  for (const ModelEdge& e : model.edges())
+    width = std::max(width, e.name.size());
+  constexpr int kPointWidth = 23;  // "(-100.00, -100.00, 10.00)" fits, aligned below
+  std::ostringstream out;
+  out << "\n  id  " << std::left << std::setw(width) << "name"
+      << "  from (m)                 to (m)\n";
+  for (const ModelEdge& e : model.edges()) {
+    out << std::right << std::setw(4) << e.id << "  " << std::left << std::setw(width)
+        << (e.name.empty() ? "-" : e.name) << "  " << std::setw(kPointWidth)
+        << PointText(e.segment.a) << "  ";
+    if (e.vertical) {
+      out << std::setw(kPointWidth) << PointText(e.segment.b) << "  vertical\n";
+    } else {
+      out << PointText(e.segment.b) << "\n";
+    }
+  }
+  return out.str();
+}
+
 int RunModelInfo(const ModelInfoOptions& opt) {
   WireframeOptions wire_options;
   wire_options.vertical_tolerance_deg = opt.vertical_tolerance_deg;
@@ -209,6 +253,7 @@ int RunModelInfo(const ModelInfoOptions& opt) {
                            {"mean_us", stats.mean_us},
                            {"median_us", stats.median_us}};
   }
+  if (opt.edges) info["edge_list"] = EdgeListJson(model);
   if (opt.json) {
     std::cout << info.dump(2) << std::endl;
     return kExitOk;
@@ -227,6 +272,7 @@ int RunModelInfo(const ModelInfoOptions& opt) {
         << stats.selectivity << std::setprecision(2) << "), " << stats.mean_us << " us mean, "
         << stats.median_us << " us median\n";
   }
+  if (opt.edges) out << EdgeListText(model);
   std::cout << out.str();
   return kExitOk;
 }
@@ -241,6 +287,9 @@ void AddModelInfo(CLI::App& cli, CommandAction* action) {
                          "navigable area and the number of view-invariant regions of a .cao model");
   cmd->add_option("model", opt->model_path, "ViSP .cao model file")->required();
   cmd->add_flag("--json", opt->json, "Print one JSON object instead of a table");
+  cmd->add_flag("--edges", opt->edges,
+                "Also list every edge: its id (as localize reports matches), its name (the .cao "
+                "name= of its line, else of the faces it borders) and end points");
   cmd->add_option("--nav", opt->sidecar_path,
                   "Navigable-area polygon file (default: MODEL.nav.json next to the model when "
                   "it exists, else derived from the walls)");
@@ -262,7 +311,11 @@ void AddModelInfo(CLI::App& cli, CommandAction* action) {
                   "Prior heading margin delta_phi (degrees)")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunModelInfo(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnless(*cmd, opt->queries > 0, {"--query-radius", "--query-margin"},
+                 "applies to the VIR queries of --queries N");
+    *action = [opt] { return RunModelInfo(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -32,7 +32,8 @@ using Clock = std::chrono::steady_clock;
 
 struct ReplayOptions {
   std::string input, model, camera, prior_file, prior, init_pose, settings, ground_truth, out;
-  double height = std::nan(""), tilt_deg = std::nan("");
+  double height = 0.0, tilt_deg = 0.0;
+  bool has_height = false, has_tilt = false;  // --height, --tilt given
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
   double fps = 0.0;
@@ -105,16 +106,16 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   if (has_prior && !opt.prior_file.empty()) {
     throw InputError("replay: give either --prior-file or --prior, not both");
   }
-  const bool has_height_tilt = std::isfinite(opt.height) || std::isfinite(opt.tilt_deg);
-  if ((has_prior || has_height_tilt) &&
-      !(std::isfinite(opt.height) && std::isfinite(opt.tilt_deg))) {
-    throw InputError("replay: --prior needs both --height and --tilt");
+  const bool has_height_tilt = opt.has_height || opt.has_tilt;
+  if ((has_prior || has_height_tilt) && !(opt.has_height && opt.has_tilt)) {
+    throw InputError(has_prior ? "replay: --prior needs both --height and --tilt"
+                               : "replay: --height and --tilt go together");
   }
   if (!has_prior && opt.prior_file.empty() && opt.init_pose.empty()) {
     throw InputError("replay: nothing to start from: give --init-pose, --prior-file or --prior");
   }
   if (has_height_tilt) {
-    CheckRange(opt.height, 0.0, 100.0, "--height");
+    CheckHeight(opt.height, "--height");
     CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   }
   CheckRange(opt.delta_t, 0.0, 100.0, "--delta-t");
@@ -124,7 +125,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   if (has_prior) s.initial_prior = ParsePrior(opt.prior, "--prior");
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
-  s.camera = ReadCameraXml(opt.camera);
+  s.camera = LoadCamera(opt.camera);
   TrackerSettings base;
   base.visibility.scanline = opt.scanline;
   s.settings = opt.settings.empty() ? base : ReadTrackerSettings(opt.settings, base);
@@ -206,143 +207,181 @@ class Progress {
   Clock::time_point start_ = Clock::now(), last_;
 };
 
-int RunReplay(const ReplayOptions& opt) {
-  ReplaySetup s = Prepare(opt);
-  LocalizerCache cache{LocalizerOptions()};
-  const LoadedModel& loaded = cache.Model(opt.model);
-  EdgeTracker tracker(opt.model, s.camera, s.settings);
-  std::unique_ptr<Localizer> localizer;
-  std::unique_ptr<Relocalizer> relocalizer;
-  if (s.robot) {
-    LocalizerOptions matcher;
-    matcher.noise = DetectedLineNoise();  // lines from LineExtractor
-    localizer = std::make_unique<Localizer>(*loaded.model, loaded.regions.get(), loaded.area.get(),
-                                            s.camera, matcher);
-    RelocalizationOptions relocalization;
-    relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
-    // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
-    relocalizer = std::make_unique<Relocalizer>(
-        *localizer, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
+// The localiser, tracker and model of one replay, built before any output is written.
+class ReplayTracking {
+ public:
+  ReplayTracking(const ReplayOptions& opt, const ReplaySetup& s)
+      : camera_(s.camera),
+        loaded_(cache_.Model(opt.model)),
+        tracker_(opt.model, s.camera, s.settings) {
+    if (s.robot) {
+      LocalizerOptions matcher;
+      matcher.noise = DetectedLineNoise();  // lines from LineExtractor
+      localizer_ = std::make_unique<Localizer>(*loaded_.model, loaded_.regions.get(),
+                                               loaded_.area.get(), s.camera, matcher);
+      RelocalizationOptions relocalization;
+      relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
+      // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
+      relocalizer_ = std::make_unique<Relocalizer>(
+          *localizer_, MakeLineExtractorFunction(opt.lines.Options()), relocalization);
+    }
+    sequence_ = std::make_unique<SequenceTracker>(&tracker_, s.camera, relocalizer_.get(),
+                                                  SequenceTrackerOptions());
+    if (s.start_pose) sequence_->SetStartPose(*s.start_pose);
+    if (s.initial_prior) sequence_->SetInitialPrior(*s.initial_prior);
+    occlusion_ = std::make_unique<OcclusionTester>(*loaded_.model);
   }
-  SequenceTracker sequence(&tracker, s.camera, relocalizer.get(), SequenceTrackerOptions());
-  if (s.start_pose) sequence.SetStartPose(*s.start_pose);
-  if (s.initial_prior) sequence.SetInitialPrior(*s.initial_prior);
-  const OcclusionTester occlusion(*loaded.model);
 
-  // Everything is valid: the outputs appear from here on, frame by frame.
-  EnsureDirectory(opt.out);
-  ReplayLog log(opt.out, s.ground_truth->enabled());
+  SequenceTracker& sequence() { return *sequence_; }
+
+  // The model edges visible at `cam_from_world`, in pixels of the undistorted frame.
+  std::vector<Segment2> VisibleEdges(const Eigen::Isometry3d& cam_from_world) const {
+    std::vector<Segment2> edges;
+    for (const ProjectedEdge& e :
+         ProjectVisibleEdges(*loaded_.model, *occlusion_, cam_from_world, camera_.Undistorted())) {
+      edges.push_back(e.image);
+    }
+    return edges;
+  }
+
+ private:
+  CameraIntrinsics camera_;
+  LocalizerCache cache_{LocalizerOptions()};
+  const LoadedModel& loaded_;
+  EdgeTracker tracker_;
+  std::unique_ptr<Localizer> localizer_;
+  std::unique_ptr<Relocalizer> relocalizer_;
+  std::unique_ptr<SequenceTracker> sequence_;
+  std::unique_ptr<OcclusionTester> occlusion_;
+};
+
+// The state of a replay's outputs as the frames go by.
+struct ReplayRun {
+  // Creates the log and the overlay in opt.out, which must exist.
+  ReplayRun(const ReplayOptions& opt, const ReplaySetup& s)
+      : out(opt.out), log(opt.out, s.ground_truth->enabled()) {
+    if (!opt.no_overlay) {
+      overlay = std::make_unique<OverlayWriter>(opt.out, opt.overlay_png, s.fps,
+                                                cv::Size(s.camera.width, s.camera.height));
+    }
+    info.input = opt.input;
+    info.model = opt.model;
+    info.camera = opt.camera;
+    info.settings = s.settings.source;
+    info.overlay_path = overlay ? overlay->path() : "";
+    info.overlay_codec = overlay ? overlay->codec() : "";
+  }
+
+  std::string out;
+  ReplayLog log;
   std::unique_ptr<OverlayWriter> overlay;
-  if (!opt.no_overlay) {
-    overlay = std::make_unique<OverlayWriter>(opt.out, opt.overlay_png, s.fps,
-                                              cv::Size(s.camera.width, s.camera.height));
-  }
   ReplayRunInfo info;
-  info.input = opt.input;
-  info.model = opt.model;
-  info.camera = opt.camera;
-  info.settings = s.settings.source;
-  info.overlay_path = overlay ? overlay->path() : "";
-  info.overlay_codec = overlay ? overlay->codec() : "";
-  auto write_summary = [&](const std::vector<ReplayFrameRecord>& records) {
-    info.losses = sequence.losses();
-    info.recoveries = sequence.recoveries();
-    WriteFileAtomically(opt.out + "/summary.json", ReplaySummary(records, info).dump(2) + "\n");
-  };
-
-  StopSignals signals;
-  Progress progress(opt.max_frames > 0 ? opt.max_frames : s.source->FrameCount(),
-                    spdlog::get_level() <= spdlog::level::info);
   std::vector<ReplayFrameRecord> records;
   int with_pose = 0;
-  const Clock::time_point start = Clock::now();
-  Clock::time_point last_summary = start;
-  double overlay_ms = 0.0, decode_ms = 0.0;
-  Frame frame = std::move(s.first);
-  info.interruption = "still running (a summary of a replay that stopped without finishing)";
-  write_summary(records);
-  while (true) {
-    const Clock::time_point step_start = Clock::now();
-    const std::optional<RobotReading> reading = ReadingAt(opt, s, frame.timestamp_s);
-    const FrameReport report = sequence.Process(frame.image, frame.timestamp_s, reading);
-    ReplayFrameRecord record;
-    record.frame = static_cast<long>(frame.frame_id);
-    record.t = frame.timestamp_s;
-    record.status = report.status;
-    record.has_pose = report.cam_from_world.has_value();
-    record.projection_error_deg = report.health.projection_error_deg;
-    record.edges_good = report.health.edges_good;
-    record.step_ms = Milliseconds(Clock::now() - step_start);
-    record.decode_ms = decode_ms;
-    if (report.cam_from_world) {
-      ++with_pose;
-      if (const auto truth = s.ground_truth->At(record.frame, record.t, 0.5 / s.fps)) {
-        const PoseDifference d = ComparePoses(*report.cam_from_world, *truth);
-        record.translation_error_m = d.translation;
-        record.rotation_error_deg = RadToDeg(d.rotation);
-      }
-    }
-    log.Add(record, report);
-    records.push_back(record);
-    if (overlay) {
-      const Clock::time_point overlay_start = Clock::now();
-      std::vector<Segment2> edges;
-      if (report.cam_from_world) {
-        for (const ProjectedEdge& e : ProjectVisibleEdges(
-                 *loaded.model, occlusion, *report.cam_from_world, s.camera.Undistorted())) {
-          edges.push_back(e.image);
-        }
-      }
-      overlay->Add(DrawOverlay(sequence.undistorted(), edges, report, record.frame, record.t),
-                   record.frame);
-      overlay_ms += Milliseconds(Clock::now() - overlay_start);
-    }
-    progress.Update(static_cast<long>(records.size()), with_pose);
-    info.wall_s = Milliseconds(Clock::now() - start) / 1000.0;
-    info.overlay_s = overlay_ms / 1000.0;
-    if (Clock::now() - last_summary > std::chrono::seconds(2)) {
-      write_summary(records);
-      last_summary = Clock::now();
-    }
-    if (StopSignals::Received() != 0) {
-      info.interruption = StopSignals::ReceivedName();
-      break;
-    }
-    if (opt.max_frames > 0 && static_cast<long>(records.size()) >= opt.max_frames) {
-      info.complete = true;
-      break;
-    }
-    const Clock::time_point grab_start = Clock::now();
-    FrameStatus status;
-    try {
-      status = s.source->Grab(&frame);
-    } catch (const InputError& e) {
-      info.interruption = std::string("the source failed: ") + e.what();
-      break;
-    }
-    decode_ms = Milliseconds(Clock::now() - grab_start);
-    if (status == FrameStatus::kEndOfStream) {
-      info.complete = true;
-      break;
-    }
-    if (status != FrameStatus::kOk) {
-      info.interruption = std::string("the source stopped: ") + ToString(status);
-      break;
+  double overlay_ms = 0.0;
+  double decode_ms = 0.0;  // reading the frame being processed
+  Clock::time_point start = Clock::now(), last_summary = start;
+};
+
+// Writes summary.json as the run stands (atomically: a reader never sees a partial file).
+void WriteSummary(const SequenceTracker& sequence, ReplayRun* run) {
+  run->info.losses = sequence.losses();
+  run->info.recoveries = sequence.recoveries();
+  WriteFileAtomically(run->out + "/summary.json",
+                      ReplaySummary(run->records, run->info).dump(2) + "\n");
+}
+
+// What the log and the summary keep of one processed frame; errors against the ground truth
+// when it has the frame.
+ReplayFrameRecord RecordFrame(const Frame& frame, const FrameReport& report, const ReplaySetup& s) {
+  ReplayFrameRecord record;
+  record.frame = static_cast<long>(frame.frame_id);
+  record.t = frame.timestamp_s;
+  record.status = report.status;
+  record.has_pose = report.cam_from_world.has_value();
+  record.projection_error_deg = report.health.projection_error_deg;
+  record.edges_good = report.health.edges_good;
+  if (report.cam_from_world) {
+    if (const auto truth = s.ground_truth->At(record.frame, record.t, 0.5 / s.fps)) {
+      const PoseDifference d = ComparePoses(*report.cam_from_world, *truth);
+      record.translation_error_m = d.translation;
+      record.rotation_error_deg = RadToDeg(d.rotation);
     }
   }
-  progress.Update(static_cast<long>(records.size()), with_pose, true);
-  if (overlay) overlay->Close();
-  info.wall_s = Milliseconds(Clock::now() - start) / 1000.0;
-  if (info.complete) info.interruption.clear();
-  if (const std::optional<cv::Mat> plot = DrawErrorPlot(records)) {
-    info.error_plot = "error_plot.png";
+  return record;
+}
+
+// Processes one frame: tracks it, logs it and draws its overlay.
+void ProcessFrame(const ReplayOptions& opt, const ReplaySetup& s, const Frame& frame,
+                  ReplayTracking* tracking, ReplayRun* run) {
+  SequenceTracker& sequence = tracking->sequence();
+  const Clock::time_point step_start = Clock::now();
+  const std::optional<RobotReading> reading = ReadingAt(opt, s, frame.timestamp_s);
+  const FrameReport report = sequence.Process(frame.image, frame.timestamp_s, reading);
+  ReplayFrameRecord record = RecordFrame(frame, report, s);
+  record.step_ms = Milliseconds(Clock::now() - step_start);
+  record.decode_ms = run->decode_ms;
+  run->with_pose += record.has_pose ? 1 : 0;
+  run->log.Add(record, report);
+  run->records.push_back(record);
+  if (!run->overlay) return;
+  const Clock::time_point overlay_start = Clock::now();
+  const std::vector<Segment2> edges = report.cam_from_world
+                                          ? tracking->VisibleEdges(*report.cam_from_world)
+                                          : std::vector<Segment2>();
+  run->overlay->Add(DrawOverlay(sequence.undistorted(), edges, report, record.frame, record.t),
+                    record.frame);
+  run->overlay_ms += Milliseconds(Clock::now() - overlay_start);
+}
+
+// Grabs the next frame into *frame; false when the run ends here (the reason in run->info).
+bool GrabNext(const ReplayOptions& opt, const ReplaySetup& s, Frame* frame, ReplayRun* run) {
+  if (StopSignals::Received() != 0) {
+    run->info.interruption = StopSignals::ReceivedName();
+    return false;
+  }
+  if (opt.max_frames > 0 && static_cast<long>(run->records.size()) >= opt.max_frames) {
+    run->info.complete = true;
+    return false;
+  }
+  const Clock::time_point grab_start = Clock::now();
+  FrameStatus status;
+  try {
+    status = s.source->Grab(frame);
+  } catch (const InputError& e) {
+    run->info.interruption = std::string("the source failed: ") + e.what();
+    return false;
+  }
+  run->decode_ms = Milliseconds(Clock::now() - grab_start);
+  if (status == FrameStatus::kEndOfStream) {
+    run->info.complete = true;
+    return false;
+  }
+  if (status != FrameStatus::kOk) {
+    run->info.interruption = std::string("the source stopped: ") + ToString(status);
+    return false;
+  }
+  return true;
+}
+
+// Closes the overlay, writes the error plot and the final summary.
+void FinishFiles(const SequenceTracker& sequence, ReplayRun* run) {
+  if (run->overlay) run->overlay->Close();
+  run->info.wall_s = Milliseconds(Clock::now() - run->start) / 1000.0;
+  if (run->info.complete) run->info.interruption.clear();
+  if (const std::optional<cv::Mat> plot = DrawErrorPlot(run->records)) {
+    run->info.error_plot = "error_plot.png";
     std::vector<unsigned char> png;
     cv::imencode(".png", *plot, png);
-    WriteFileAtomically(opt.out + "/error_plot.png", std::string(png.begin(), png.end()));
+    WriteFileAtomically(run->out + "/error_plot.png", std::string(png.begin(), png.end()));
   }
-  write_summary(records);
-  const nlohmann::ordered_json summary = ReplaySummary(records, info);
-  std::cout << "replayed " << records.size() << " frames: " << with_pose << " with a pose ("
+  WriteSummary(sequence, run);
+}
+
+// The one line on stdout: frames, poses, losses, throughput and, with ground truth, the errors.
+void PrintReplayLine(const SequenceTracker& sequence, const ReplayRun& run) {
+  const nlohmann::ordered_json summary = ReplaySummary(run.records, run.info);
+  std::cout << "replayed " << run.records.size() << " frames: " << run.with_pose << " with a pose ("
             << summary["status_counts"].dump() << "), " << sequence.losses() << " losses, "
             << sequence.recoveries() << " recoveries, "
             << static_cast<int>(summary["throughput_fps"].get<double>())
@@ -353,8 +392,36 @@ int RunReplay(const ReplayOptions& opt) {
               << summary["ground_truth"]["translation_m"]["max"].get<double>() * 100.0 << " cm / "
               << summary["ground_truth"]["rotation_deg"]["max"].get<double>() << " deg";
   }
-  std::cout << (info.complete ? "" : " (interrupted: " + info.interruption + ")") << std::endl;
-  return info.complete && with_pose > 0 ? kExitOk : kExitJobFailed;
+  std::cout << (run.info.complete ? "" : " (interrupted: " + run.info.interruption + ")")
+            << std::endl;
+}
+
+int RunReplay(const ReplayOptions& opt) {
+  ReplaySetup s = Prepare(opt);
+  ReplayTracking tracking(opt, s);
+  // Everything is valid: the outputs appear from here on, frame by frame.
+  EnsureDirectory(opt.out);
+  ReplayRun run(opt, s);
+  StopSignals signals;
+  Progress progress(opt.max_frames > 0 ? opt.max_frames : s.source->FrameCount(),
+                    spdlog::get_level() <= spdlog::level::info);
+  run.info.interruption = "still running (a summary of a replay that stopped without finishing)";
+  WriteSummary(tracking.sequence(), &run);
+  Frame frame = std::move(s.first);
+  do {
+    ProcessFrame(opt, s, frame, &tracking, &run);
+    progress.Update(static_cast<long>(run.records.size()), run.with_pose);
+    run.info.wall_s = Milliseconds(Clock::now() - run.start) / 1000.0;
+    run.info.overlay_s = run.overlay_ms / 1000.0;
+    if (Clock::now() - run.last_summary > std::chrono::seconds(2)) {
+      WriteSummary(tracking.sequence(), &run);
+      run.last_summary = Clock::now();
+    }
+  } while (GrabNext(opt, s, &frame, &run));
+  progress.Update(static_cast<long>(run.records.size()), run.with_pose, true);
+  FinishFiles(tracking.sequence(), &run);
+  PrintReplayLine(tracking.sequence(), run);
+  return run.info.complete && run.with_pose > 0 ? kExitOk : kExitJobFailed;
 }
 
 }  // namespace
@@ -368,7 +435,8 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--input", opt->input, "Video file or printf image pattern 'DIR/frame_%05d.png'")
       ->required();
   cmd->add_option("--model", opt->model, "ViSP .cao model")->required();
-  cmd->add_option("--camera", opt->camera, "ViSP camera XML (its distortion is undone)")
+  cmd->add_option("--camera", opt->camera,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (its distortion is undone)")
       ->required();
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option("--prior-file", opt->prior_file,
@@ -397,7 +465,21 @@ void AddReplay(CLI::App& cli, CommandAction* action) {
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   cmd->add_flag("--scanline", opt->scanline,
                 "Scan-line visibility (hidden edge parts not tracked; about 4x slower)");
-  cmd->callback([opt, action] { *action = [opt] { return RunReplay(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    opt->has_height = cmd->count("--height") > 0;
+    opt->has_tilt = cmd->count("--tilt") > 0;
+    const bool robot = opt->has_height || opt->has_tilt || cmd->count("--prior") > 0 ||
+                       cmd->count("--prior-file") > 0;
+    RefuseUnless(*cmd, cmd->count("--prior-file") == 0, {"--height", "--tilt"},
+                 "not with --prior-file (it gives each frame's height and tilt)");
+    RefuseUnless(*cmd, robot,
+                 {"--delta-t", "--delta-phi", "--detector", "--min-length", "--roi", "--no-merge",
+                  "--undistort"},
+                 "applies to the matcher, which needs a robot's readings (--prior-file, or "
+                 "--prior with --height and --tilt)");
+    RefuseUnless(*cmd, !opt->no_overlay, {"--overlay-png"}, "not with --no-overlay");
+    *action = [opt] { return RunReplay(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -79,8 +79,8 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   o.count = opt.count;
   const auto [h_lo, h_hi] = ParseRange(opt.height_range, "--height-range");
   const auto [t_lo, t_hi] = ParseRange(opt.tilt_range, "--tilt-range");
-  CheckRange(h_lo, 0.0, 100.0, "--height-range");
-  CheckRange(h_hi, 0.0, 100.0, "--height-range");
+  CheckHeight(h_lo, "--height-range");
+  CheckHeight(h_hi, "--height-range");
   CheckRange(t_lo, -89.0, 89.0, "--tilt-range");
   CheckRange(t_hi, -89.0, 89.0, "--tilt-range");
   o.height_min = h_lo;
@@ -116,7 +116,7 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   if (opt.exact) o.shorten_max = o.split_probability = 0.0;
   o.parallel_clutter = opt.parallel_clutter;
   if (!opt.camera_path.empty()) {
-    o.camera = ReadCameraXml(opt.camera_path);
+    o.camera = LoadCamera(opt.camera_path);
     if (o.camera.width <= 0 || o.camera.height <= 0) {
       throw InputError(Located(opt.camera_path, 0, "the camera file gives no image size"));
     }
@@ -260,8 +260,10 @@ void AddSynth(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--tilt-range", opt->tilt_range, "Camera tilt range LO,HI (degrees)")
       ->capture_default_str();
-  cmd->add_option("--camera", opt->camera_path,
-                  "ViSP camera XML (default: 640x480, px = py = 1000, centre 320,240)");
+  cmd->add_option(
+      "--camera", opt->camera_path,
+      "Camera file: ViSP XML, OpenCV or ROS YAML (default: 640x480, px = py = 1000, centre "
+      "320,240)");
   cmd->add_option("--calibration-sigma", opt->calibration_sigma,
                   "Std of the multiplicative focal-length error eps_m")
       ->capture_default_str();
@@ -276,6 +278,8 @@ void AddSynth(CLI::App& cli, CommandAction* action) {
   cmd->callback([opt, action, cmd] {
     opt->has_delta_t = cmd->count("--delta-t") > 0;
     opt->has_delta_phi = cmd->count("--delta-phi") > 0;
+    RefuseUnless(*cmd, !opt->exact, {"--calibration-sigma", "--angle-sigma", "--offset-sigma"},
+                 "not with --exact (no calibration error or line noise)");
     *action = [opt] { return RunSynth(*opt); };
   });
 }

@@ -48,6 +48,16 @@ bool RenderSceneOptions::Check(std::string* why) const {
   return true;
 }
 
+RenderSurface PlanarSurface(std::vector<Eigen::Vector3d> polygon, SurfaceKind kind, double albedo) {
+  RenderSurface s;
+  s.kind = kind;
+  s.normal = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]).normalized();
+  s.offset = s.normal.dot(polygon[0]);
+  s.polygon = std::move(polygon);
+  s.albedo = std::clamp(albedo, 0.0, 1.0);
+  return s;
+}
+
 double FaceAlbedo(int face, bool outer_wall, uint64_t seed) {
   const double phase = HashUnit(HashCombine(seed, 0xa1bed0ull));
   const double u = std::fmod(phase + face * kGoldenFraction, 1.0);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "models/errors.h"
 
@@ -65,10 +66,11 @@ std::vector<Segment2> MeasuredPieces(const Segment2& image, bool fragment,
 }
 
 // The image of a random unmodelled vertical segment standing on the floor in front of the
-// camera, visible (not behind a wall) and long enough; false when none was found.
-bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
-                         const OcclusionTester& occlusion, const NavigableArea& area,
-                         const SyntheticSceneOptions& o, SceneRandom* rng, Segment2* line) {
+// camera, visible (not behind a wall) and long enough; nullopt when none was found.
+std::optional<Segment2> VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
+                                            const OcclusionTester& occlusion,
+                                            const NavigableArea& area,
+                                            const SyntheticSceneOptions& o, SceneRandom* rng) {
   const Eigen::Isometry3d cam_from_world = CamFromWorld(truth);
   const double half_fov = std::atan2(0.5 * camera.width, camera.px);
   for (int i = 0; i < kMaxClutterDraws; ++i) {
@@ -89,10 +91,9 @@ bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
                          camera.Project(cam_from_world * segment.b)};
     const std::vector<Segment2> pieces = MeasuredPieces(image, false, o, rng);
     if (pieces.empty()) continue;
-    *line = pieces.front();
-    return true;
+    return pieces.front();
   }
-  return false;
+  return std::nullopt;
 }
 
 // A random image segment: midpoint uniform in the image, direction uniform, length uniform in
@@ -209,8 +210,11 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
   const int vertical = static_cast<int>(std::lround(clutter * o.vertical_clutter_fraction));
   for (int k = 0; k < clutter; ++k) {
     LabelledLine line;
-    line.vertical_clutter = k < vertical && VerticalClutterLine(scene.truth, camera, occlusion,
-                                                                area, o, &rng, &line.line);
+    const std::optional<Segment2> vertical_line =
+        k < vertical ? VerticalClutterLine(scene.truth, camera, occlusion, area, o, &rng)
+                     : std::nullopt;
+    line.vertical_clutter = vertical_line.has_value();
+    if (vertical_line) line.line = *vertical_line;
     if (line.vertical_clutter || RandomClutterLine(o, &rng, &line.line)) lines.push_back(line);
   }
   const double radius = o.delta_t * std::sqrt(rng.Uniform(0.0, 1.0));

@@ -161,6 +161,22 @@ TEST_F(LiveCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
     EXPECT_NE(err.find(what), std::string::npos) << args << ": " << err;
     EXPECT_FALSE(fs::exists(out_)) << args;
   }
+  const std::string without_height =
+      " --model " + kModel + " --camera " + kCamera + " --out " + out_.string();
+  const std::vector<std::pair<std::string, std::string>> more = {
+      {"--source sim --head sim --prior 3,1.5,20 --height -1", "--height"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 0", "--height"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 1.3 --estimator truth --settings s.xml",
+       "--settings"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 1.3 --camera-fps 30", "--camera-fps"},
+  };
+  for (const auto& [args, what] : more) {
+    std::string err;
+    EXPECT_EQ(Live(args + without_height, &err), 2) << args;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;
+    EXPECT_NE(err.find(what), std::string::npos) << args << ": " << err;
+    EXPECT_FALSE(fs::exists(out_)) << args;
+  }
   std::string err;
   EXPECT_EQ(Live("--source sim --head sim --prior 3,1.5,20 --height 1.3 --model /nonexistent.cao "
                  "--camera " +

@@ -1,7 +1,7 @@
 // `linetrack replay` end to end: Castle-simu started from its first pose file with the ground
 // truth as a pattern of pose files, a rendered hall sequence started by the matcher from its prior
 // file, a source that breaks in the middle (files valid up to the last frame, summary saying so),
-// and bad input (exit 2, one line, no output folder).
+// and bad input, flags that cannot apply among it (exit 2, one line, no output folder).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -153,6 +153,36 @@ TEST_F(ReplayCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
     EXPECT_FALSE(fs::exists(out)) << args;
   }
+}
+
+TEST_F(ReplayCli, HeightAndInapplicableFlagsAreBadInput) {
+  const fs::path out = dir_ / "never";
+  const std::string castle = CastleArgs(castle_ + "/Images/Image_%04d.pgm", out);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {castle + " --prior 1,2,30 --height -1 --tilt 0", "--height"},
+      {castle + " --prior 1,2,30 --height 0 --tilt 0", "--height"},
+      {castle + " --prior 1,2,30 --height nan --tilt 0", "--height"},
+      {castle + " --overlay-png --no-overlay", "--overlay-png"},
+      {castle + " --delta-t 1", "--delta-t"},      // no robot: no matcher to bound
+      {castle + " --detector lsd", "--detector"},  // nor to extract lines for
+      {castle + " --prior-file p.csv --tilt 3", "--tilt"},
+  };
+  for (const auto& [args, flag] : bad) {
+    const CommandRun run = Linetrack(args);
+    EXPECT_EQ(run.code, 2) << args << "\n" << run.err;
+    EXPECT_NE(run.err.find(flag), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+}
+
+TEST_F(ReplayCli, QuietAfterTheSubcommand) {
+  const fs::path out = dir_ / "quiet";
+  const CommandRun run = Linetrack(CastleArgs(castle_ + "/Images/Image_%04d.pgm", out) +
+                                   " --frames 3 --no-overlay -q");
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_TRUE(run.err.empty()) << run.err;
+  EXPECT_NE(run.out.find("replayed 3 frames"), std::string::npos) << run.out;
 }
 
 TEST_F(ReplayCli, HelpNamesTheOptions) {

@@ -152,7 +152,7 @@ TEST(HeadKinematics, ForwardModelFollowsTheConventions) {
   EXPECT_TRUE(pose.linear().col(2).isApprox(Eigen::Vector3d::UnitY()));  // pan is CCW
   const double tilt = DegToRad(20.0);
   pose = BaseFromCamera(centred, 0.0, tilt);
-  // method.md: optical axis (cos t cos h, cos t sin h, -sin t).
+  // docs/conventions.md: optical axis (cos t cos h, cos t sin h, -sin t).
   EXPECT_TRUE(pose.linear().col(2).isApprox(Eigen::Vector3d(std::cos(tilt), 0, -std::sin(tilt))));
 }
 

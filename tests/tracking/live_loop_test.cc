@@ -72,8 +72,9 @@ std::unique_ptr<SimulatedLiveRig> Rig(const SimCameraOptions& camera, const Live
                                       double pan_offset, double tilt_offset) {
   SimHeadStart start;
   start.offset_from_target = Eigen::Vector2d(pan_offset, tilt_offset);
-  return std::make_unique<SimulatedLiveRig>(Hall(), &HallArea(), PaperCamera(), camera,
-                                            SimulatedHeadOptions{}, loop, start);
+  return std::make_unique<SimulatedLiveRig>(
+      Hall(), &HallArea(), PaperCamera(),
+      SimulatedLiveRigOptions{camera, SimulatedHeadOptions{}, loop, start, {}});
 }
 
 // Every frame: joints within their limits, head rates and commands within the maximum speeds.
@@ -244,9 +245,9 @@ TEST(LiveLoop, ServosAPtuThroughItsSerialProtocol) {
   LiveLoopOptions loop_options;
   loop_options.target = kPillarCorner;
   loop_options.crossing_height = camera.crossing_height();
-  LiveLoop loop(
-      &camera, driver.get(), &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
-      PaperCamera(), loop_options);
+  LiveLoop loop(LiveLoopParts{&camera, driver.get(), &truth,
+                              [&camera](double t) { return camera.OdometryAt(t); }},
+                Hall(), PaperCamera(), loop_options);
   LiveIteration it;
   double start_error_px = 0.0, late_max_error_px = 0.0;
   for (int k = 0; k < 150; ++k) {  // 5 s
@@ -319,8 +320,8 @@ TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
   loop_options.target = kPillarCorner;
   loop_options.crossing_height = camera.crossing_height();
   LiveLoop loop(
-      &camera, &head, &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
-      PaperCamera(), loop_options);
+      LiveLoopParts{&camera, &head, &truth, [&camera](double t) { return camera.OdometryAt(t); }},
+      Hall(), PaperCamera(), loop_options);
   for (int k = 0; k < 5; ++k)
     ASSERT_EQ(loop.Step().command, HeadCommand::kVelocity);  // turning
   head.refuse = true;
@@ -339,8 +340,8 @@ TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
 
 TEST(LiveLoop, TargetDefaultsToTheCentroidOfTheVisibleModel) {
   const SimCameraOptions camera = StillBase({3.0, 1.5, DegToRad(20.0)});
-  SimulatedLiveRig rig(Hall(), &HallArea(), PaperCamera(), camera, SimulatedHeadOptions{},
-                       LiveLoopOptions{});
+  SimulatedLiveRig rig(Hall(), &HallArea(), PaperCamera(),
+                       SimulatedLiveRigOptions{camera, SimulatedHeadOptions{}, {}, {}, {}});
   const LiveIteration first = rig.loop().Step();
   ASSERT_TRUE(first.has_target);
   ASSERT_TRUE(rig.loop().target().has_value());

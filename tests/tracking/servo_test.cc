@@ -127,7 +127,7 @@ TEST(HeadServo, OneStepReducesTheErrorAtTheGainThroughTheRealKinematics) {
     const Eigen::Vector2d desired(300.0, 250.0);
     const Eigen::Vector3d seen = CamFromWorldOnHead(geometry, base, 1.2, pan, tilt) * target;
     const ServoStep step =
-        servo.Compute(0.0, seen, desired, camera, pan, tilt, {-3, 3, -1, 1, 100, 100});
+        servo.Compute(0.0, seen, desired, camera, {pan, tilt, {-3, 3, -1, 1, 100, 100}});
     ASSERT_TRUE(step.ok) << step.reason;
     EXPECT_FALSE(step.converged);
     EXPECT_FALSE(step.saturated);
@@ -161,16 +161,16 @@ TEST(HeadServo, HoldsAtConvergenceWithHysteresis) {
   auto at_pixel_offset = [&](double du) {
     return Eigen::Vector3d(du / camera.px * 4.0, 0.0, 4.0);  // 4 m ahead, du pixels right
   };
-  ServoStep s = servo.Compute(0.0, at_pixel_offset(1.0), desired, camera, 0, 0, WideLimits());
+  ServoStep s = servo.Compute(0.0, at_pixel_offset(1.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_FALSE(s.converged);  // 1 px > 0.5 px: not converged yet
   EXPECT_NE(s.pan_rate, 0.0);
-  s = servo.Compute(0.1, at_pixel_offset(0.2), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.1, at_pixel_offset(0.2), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);
   EXPECT_EQ(s.pan_rate, 0.0);
   EXPECT_EQ(s.tilt_rate, 0.0);
-  s = servo.Compute(0.2, at_pixel_offset(1.5), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.2, at_pixel_offset(1.5), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);  // still holding below 2 px
-  s = servo.Compute(0.3, at_pixel_offset(3.0), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.3, at_pixel_offset(3.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_FALSE(s.converged);
   EXPECT_LT(s.pan_rate, 0.0);  // target to the right: pan clockwise (negative)
 }
@@ -187,9 +187,9 @@ TEST(HeadServo, FollowsAMovingTargetInsteadOfHolding) {
   auto seen_at = [&](double t) {  // moving right, head fixed at zero
     return Eigen::Vector3d(speed_px_s * t / camera.px * depth, 0.0, depth);
   };
-  ServoStep s = servo.Compute(0.0, seen_at(0.0), desired, camera, 0, 0, WideLimits());
+  ServoStep s = servo.Compute(0.0, seen_at(0.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);  // no motion known yet, error 0
-  s = servo.Compute(dt, seen_at(dt), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(dt, seen_at(dt), desired, camera, {0, 0, WideLimits()});
   EXPECT_NEAR(s.target_speed_px_s, speed_px_s, 1e-6);
   EXPECT_FALSE(s.converged);
   EXPECT_TRUE(s.compensated);
@@ -203,7 +203,7 @@ TEST(HeadServo, FollowsAMovingTargetInsteadOfHolding) {
 TEST(HeadServo, NoCommandForATargetBehindTheCamera) {
   HeadServo servo(HeadServoOptions{});
   const ServoStep s = servo.Compute(0.0, Eigen::Vector3d(0.0, 0.0, -2.0), {320.0, 240.0},
-                                    PaperCamera(), 0.0, 0.0, WideLimits());
+                                    PaperCamera(), {0.0, 0.0, WideLimits()});
   EXPECT_FALSE(s.ok);
   EXPECT_EQ(s.pan_rate, 0.0);
   EXPECT_NE(s.reason.find("behind"), std::string::npos);

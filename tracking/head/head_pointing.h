@@ -1,7 +1,7 @@
 // Where a camera on a pan-tilt head looks from a robot base in the world, and the head angles that
 // look at a world point. Frames: the head's base frame has its origin where the pan and tilt axes
 // cross, x forward along the robot's heading, z up (head_kinematics.h); the camera pose on it is
-// BaseFromCamera(geometry, pan, tilt). Conventions of ../shared/docs/method.md.
+// BaseFromCamera(geometry, pan, tilt). Conventions of docs/conventions.md.
 #pragma once
 
 #include <Eigen/Geometry>

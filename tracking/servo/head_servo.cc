@@ -114,7 +114,9 @@ void HeadServo::Reset() {
 
 ServoStep HeadServo::Compute(double t, const Eigen::Vector3d& target_cam,
                              const Eigen::Vector2d& desired_px, const CameraIntrinsics& camera,
-                             double pan, double tilt, const HeadLimits& limits) {
+                             const HeadJoints& head) {
+  const double pan = head.pan, tilt = head.tilt;
+  const HeadLimits& limits = head.limits;
   ServoStep step;
   Impl& m = *impl_;
   if (!(target_cam.z() > 1e-6) || !target_cam.allFinite()) {

@@ -107,12 +107,22 @@ class PoseParameters {
   Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
 };
 
+// The unknowns of a solve, its residuals (pixels, one per edge point) and J^T W J at them.
+struct IrlsState {
+  Eigen::VectorXd p, r;
+  Eigen::MatrixXd information;
+};
+
 // Iteratively reweighted Gauss-Newton (Huber weights) on the point-to-line distances of the edge
-// points of `edges`, from the parameters `p` (updated). `r` receives the residuals at the result
-// and `information` J^T W J there. False when an edge falls behind the camera or a step fails.
+// points of `edges`, from the parameters state->p (updated, r sized to the points). state->r
+// receives the residuals at the result and state->information J^T W J there. False when an edge
+// falls behind the camera or a step fails.
 bool SolveIrls(const std::vector<ViewedEdge>& edges, const CameraIntrinsics& camera,
                const PoseParameters& parameters, const EdgeRefinementOptions& options,
-               Eigen::VectorXd* p, Eigen::VectorXd* r, Eigen::MatrixXd* information) {
+               IrlsState* state) {
+  Eigen::VectorXd* p = &state->p;
+  Eigen::VectorXd* r = &state->r;
+  Eigen::MatrixXd* information = &state->information;
   const int dof = parameters.size();
   const int n = static_cast<int>(r->size());
   Eigen::VectorXd r_step(n), w(n);
@@ -182,18 +192,20 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
 
   const PoseParameters parameters(start, known);
   const int dof = parameters.size();
-  Eigen::VectorXd r(out.points);
+  IrlsState solve;
+  Eigen::VectorXd& r = solve.r;
+  r.resize(out.points);
   if (!Residuals(used, camera, start, &r)) return out;
   out.rms_before_px = Rms(r);
 
-  Eigen::VectorXd p;
-  Eigen::MatrixXd information;
+  const Eigen::VectorXd& p = solve.p;
+  const Eigen::MatrixXd& information = solve.information;
   for (int rejections = 0;; ++rejections) {
     const int n = PointCount(used);
     if (n < options.min_points) return out;
-    p = Eigen::VectorXd::Zero(dof);
+    solve.p = Eigen::VectorXd::Zero(dof);
     r.resize(n);
-    if (!SolveIrls(used, camera, parameters, options, &p, &r, &information)) return out;
+    if (!SolveIrls(used, camera, parameters, options, &solve)) return out;
     if (rejections == options.max_edge_rejections) break;
     const std::vector<double> means = EdgeMeanResiduals(used, r);
     int worst = -1;
@@ -320,9 +332,9 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
 
 EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
                              const std::vector<Segment3>& edges,
-                             const std::vector<Eigen::Vector2d>& sites,
-                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
-                             const std::optional<KnownHeightTilt>& known) {
+                             const std::vector<Eigen::Vector2d>& sites, const RefinementStart& from,
+                             const EdgeRefinementOptions& options) {
+  const Eigen::Isometry3d& start = from.cam_from_world;
   // The model edges in view and their images at the start pose.
   std::vector<ViewedEdge> viewed;
   std::vector<Segment2> images;
@@ -361,13 +373,14 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
         SubpixelEdgeOffset(image, site, normal, options.search_px, options.min_gradient);
     if (std::isfinite(offset)) viewed[best].points.push_back(site + offset * normal);
   }
-  return SolveOnEdgePoints(std::move(viewed), camera, start, known, options);
+  return SolveOnEdgePoints(std::move(viewed), camera, start, from.known, options);
 }
 
 EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
-                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
-                            const EdgeAlignmentOptions& options,
-                            const std::optional<KnownHeightTilt>& known) {
+                            const std::vector<Segment3>& visible, const RefinementStart& from,
+                            const EdgeAlignmentOptions& options) {
+  const Eigen::Isometry3d& start = from.cam_from_world;
+  const std::optional<KnownHeightTilt>& known = from.known;
   EdgeRefinement out;
   out.cam_from_world = start;
   Eigen::Isometry3d pose = start;

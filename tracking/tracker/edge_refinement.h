@@ -44,7 +44,7 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
                           const Eigen::Vector2d& normal, double search_px, double min_gradient);
 
 // A robot camera's known height (metres) and tilt (radians): with it the refinement estimates
-// x, y and heading only, with zero roll (conventions of method.md).
+// x, y and heading only, with zero roll (docs/conventions.md).
 struct KnownHeightTilt {
   double height = 0.0;
   double tilt = 0.0;
@@ -65,15 +65,20 @@ struct EdgeRefinement {
   double heading_sigma_rad = 0.0;
 };
 
-// Refines `start` (cam_from_world) so that the model `edges` (world) pass through the sub-pixel
-// edge points found near `sites` (pixels of the undistorted `image`, e.g. ViSP's good moving
-// edges). `camera` is the undistorted camera. With `known`, the result has that height and tilt
-// and zero roll.
+// Where a refinement starts: a pose and, for a robot, its known height and tilt (the result then
+// keeps them, with zero roll).
+struct RefinementStart {
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
+  std::optional<KnownHeightTilt> known;
+};
+
+// Refines start.cam_from_world so that the model `edges` (world) pass through the sub-pixel edge
+// points found near `sites` (pixels of the undistorted `image`, e.g. ViSP's good moving edges).
+// `camera` is the undistorted camera.
 EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
                              const std::vector<Segment3>& edges,
                              const std::vector<Eigen::Vector2d>& sites,
-                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
-                             const std::optional<KnownHeightTilt>& known = std::nullopt);
+                             const RefinementStart& start, const EdgeRefinementOptions& options);
 
 // Coarse alignment of a predicted pose (e.g. from the robot's odometry) before the moving edges
 // take over: edge points are searched along the normals of the projected visible model edges,
@@ -88,12 +93,11 @@ struct EdgeAlignmentOptions {
   bool Check(std::string* why) const;
 };
 
-// Aligns `start` on the image edges near the projections of `visible` (the visible parts of the
-// model edges at `start`, world). `applied` is false when a round finds too few points or does
-// not improve.
+// Aligns start.cam_from_world on the image edges near the projections of `visible` (the visible
+// parts of the model edges at that pose, world). `applied` is false when a round finds too few
+// points or does not improve.
 EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
-                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
-                            const EdgeAlignmentOptions& options,
-                            const std::optional<KnownHeightTilt>& known = std::nullopt);
+                            const std::vector<Segment3>& visible, const RefinementStart& start,
+                            const EdgeAlignmentOptions& options);
 
 }  // namespace linetrack

@@ -85,7 +85,7 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
   }
   try {
     ScopedStdoutSilencer silence;
-    tracker->loadModel(model_path, false);
+    tracker->loadModel(model_path, /*verbose=*/false);
   } catch (const vpException& e) {
     throw InputError(
         Located(model_path, 0, std::string("ViSP cannot load the model: ") + e.getMessage()));
@@ -186,7 +186,7 @@ EdgeTrackResult EdgeTracker::Start(const vpImage<unsigned char>& image,
     result.cam_from_world = FromVispPose(tracker_->getPose());
     started_ = true;
   } catch (const vpException& e) {
-    result.reason = std::string("ViSP: ") + e.getMessage();
+    result.reason = TrackingFailureReason(e.getMessage());
   }
   return result;
 }
@@ -198,7 +198,7 @@ EdgeTrackResult EdgeTracker::StartFromPrediction(const vpImage<unsigned char>& i
   for (const ProjectedEdge& edge : ProjectVisibleEdges(*model_, *occlusion_, predicted, camera_))
     visible.push_back(edge.world);
   const EdgeRefinement aligned =
-      AlignToEdges(image, camera_, visible, predicted, settings_.alignment, known);
+      AlignToEdges(image, camera_, visible, {predicted, known}, settings_.alignment);
   if (!aligned.applied) {
     started_ = false;
     EdgeTrackResult result;
@@ -238,7 +238,7 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
     return measured;
   } catch (const vpException& e) {
     started_ = false;
-    result.reason = std::string("ViSP: ") + e.getMessage();
+    result.reason = TrackingFailureReason(e.getMessage());
     return result;
   }
 }
@@ -256,7 +256,7 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
   health.edges_good = static_cast<int>(sites.good.size());
   if (settings_.refine_subpixel) {
     const EdgeRefinement refined = RefineOnEdges(
-        image, camera_, edges_, sites.good, result.cam_from_world, settings_.refinement, known);
+        image, camera_, edges_, sites.good, {result.cam_from_world, known}, settings_.refinement);
     health.refined = refined.applied;
     health.refined_points = refined.points;
     if (refined.applied) {
@@ -281,6 +281,23 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
     health.rotation_sigma_deg = vpMath::deg(sigmas.y());
   }
   return result;
+}
+
+std::string TrackingFailureReason(const std::string& visp_message) {
+  if (visp_message.rfind("Not enough moving edges", 0) != 0) return "ViSP: " + visp_message;
+  // "Not enough moving edges (N) to track the object: expected M. Try to reduce ..." (or
+  // without the counts): N good moving edges, M needed.
+  std::string counts;
+  const size_t open = visp_message.find('('), expected = visp_message.find("expected ");
+  if (open != std::string::npos && expected != std::string::npos) {
+    const std::string found = visp_message.substr(open + 1, visp_message.find(')') - open - 1);
+    const size_t end = visp_message.find_first_not_of("0123456789", expected + 9);
+    counts = " (" + found + " where " + visp_message.substr(expected + 9, end - expected - 9) +
+             " were needed)";
+  }
+  return "too few moving edges found the model's edges in the image" + counts +
+         ": the pose is off or the edges are faint; a larger <ecm><range><tracking> or a lower "
+         "<ecm><contrast><edge_threshold> in the tracker settings file finds more";
 }
 
 }  // namespace linetrack

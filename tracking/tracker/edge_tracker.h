@@ -26,7 +26,7 @@ namespace linetrack {
 // The outcome of Start() or Track().
 struct EdgeTrackResult {
   bool ok = false;     // false: ViSP failed (reason says why); the pose is then meaningless
-  std::string reason;  // ViSP's message when !ok
+  std::string reason;  // why ViSP failed when !ok (TrackingFailureReason)
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
   // ViSP's own pose before the sub-pixel refinement (equal to cam_from_world without it).
   Eigen::Isometry3d visp_cam_from_world = Eigen::Isometry3d::Identity();
@@ -122,5 +122,11 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker);
 // own file. Throws InputError naming the model when ViSP cannot load it.
 void LoadOrientedVispModel(const CaoModel& cao, const WireframeModel& model,
                            vpMbGenericTracker* tracker);
+
+// Why ViSP's tracker failed, in the user's terms. ViSP's "not enough moving edges ... Try to reduce
+// the threshold=R using setGoodMovingEdgesRatioThreshold()" names an API call; this says what
+// failed and which keys of the tracker settings file find more moving edges. Other messages
+// come back as "ViSP: message".
+std::string TrackingFailureReason(const std::string& visp_message);
 
 }  // namespace linetrack

@@ -225,7 +225,8 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     const Clock::time_point track_start = Clock::now();
     MaybePredict(robot, &report);
     report.predict_ms = MillisecondsSince(track_start);
-    const EdgeTrackResult result = tracker_->Track(*undistorted_, false, Known(robot));
+    const EdgeTrackResult result =
+        tracker_->Track(*undistorted_, /*with_covariance=*/false, Known(robot));
     report.track_ms = MillisecondsSince(track_start);
     report.passes_ms = result.passes_ms;
     report.measure_ms = result.measure_ms;

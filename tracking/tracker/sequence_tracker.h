@@ -52,21 +52,20 @@ struct SequenceTrackerOptions {
   // aligned on the image edges before tracking when that motion moves the model's image by more
   // than prediction_min_px (RMS over the model edges in view, RmsImageMotionPx).
   double prediction_min_px = 3.0;
-  // A jump of the projection error to more than jump_ratio times its median over the last
-  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
-  // (e.g. a door casing beside the modelled edge): the pose is dropped.
   // A robot's pose must be confirmed by the sub-pixel refinement on the edges (with its height
   // and tilt); otherwise ViSP's unconstrained pose would be reported.
   bool robot_requires_refinement = true;
+  // A jump of the projection error to more than jump_ratio times its median over the last
+  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
+  // (e.g. a door casing beside the modelled edge): the pose is dropped.
   double jump_ratio = 3.0;
   double jump_floor_deg = 8.0;
   int jump_window = 15;
   // Likewise, for a robot, the sub-pixel refinement's residual (rms_after): the model edges
   // fitting the image edges more than rms_jump_ratio times worse than over the last jump_window
   // good frames (and worse than rms_jump_floor_px) means some latched onto unmodelled lines and
-  // pulled the pose (hall at 30 frames/s: 0.53 px after 0.20, 6.6 cm off). A ratio of 2 also
-  // catches the bench servo drive's 5-9 cm poses (0.30-0.50 px after 0.13-0.19) but drops good
-  // poses of the live drive test (0.34-0.42 px after 0.16-0.19): docs/tracking.md.
+  // pulled the pose while ViSP's own checks pass. A lower ratio refuses smaller pulls but also
+  // good poses whose residual merely fluctuates (the trade-off: docs/tracking.md, health).
   double rms_jump_ratio = 2.5;
   double rms_jump_floor_px = 0.3;
 
