@@ -238,6 +238,14 @@ bool ViewInvariantRegionsOptions::Check(std::string* why) const {
     *why = "grid_pitch must be 0 (no grid) or in [0.05, 1000] metres";
     return false;
   }
+  if (!(event_ray_separation_deg >= 0.0 && event_ray_separation_deg <= 90.0)) {
+    *why = "event_ray_separation_deg must be in [0, 90] degrees";
+    return false;
+  }
+  if (!(min_region_size >= 0.0 && min_region_size <= 100.0)) {
+    *why = "min_region_size must be in [0, 100] metres";
+    return false;
+  }
   if (!(hidden_margin >= 1e-6 && hidden_margin < 0.1)) {
     *why = "hidden_margin must be in [1e-6, 0.1) metres";
     return false;
@@ -299,9 +307,12 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   StoreyOccluders occluders{SegmentGrid(walls), {}, SegmentGrid({}), {}, {}, 0};
   occluders.solids = Solids(walls, cells, kMaxSolidSides);
   if (options.event_rays) {
+    EventRayOptions rays;
+    rays.range = kEventRange;
+    rays.min_separation = DegToRad(options.event_ray_separation_deg);
     for (const Segment2& ray : EventRays(PlanPoints(model, edges.ids), occluders.walls,
-                                         occluders.solids, lo, hi, kEventRange)) {
-      SplitCells(ray, &cells);
+                                         occluders.solids, Eigen::AlignedBox2d(lo, hi), rays)) {
+      SplitCells(ray, &cells, options.min_region_size);
     }
   }
   std::vector<Segment2> sides;

@@ -61,6 +61,14 @@ struct ViewInvariantRegionsOptions {
   // Cut by the event rays (from an occluding vertex away from each model vertex it can hide, up
   // to the next wall; Simsarian et al.), not only by the lines of walls and area boundaries.
   bool event_rays = true;
+  // Of the event rays from one occluding vertex, only those at least this far apart (degrees):
+  // each door jamb sees hundreds of model vertices, and their rays crossing in a corridor cut it
+  // into cells quadratic in number. Fewer rays leave coarser regions, whose lists stay
+  // conservative.
+  double event_ray_separation_deg = 5.0;
+  // Event rays split no region already under this size (metres) on both sides of its bounding
+  // box: the matcher queries disks of the prior's position uncertainty, larger than this.
+  double min_region_size = 0.5;
   // An edge counts as hidden only when the occluders block every sight line to it by at least
   // this much (metres); keeps the lists conservative against rounding and grazing sight lines.
   double hidden_margin = 1e-3;

@@ -58,7 +58,7 @@ Cell MakeCell(Ring2 ring, int parent) {
   return cell;
 }
 
-void SplitCells(const Segment2& segment, std::vector<Cell>* cells) {
+void SplitCells(const Segment2& segment, std::vector<Cell>* cells, double min_cell_size) {
   if (segment.Length() < kPlanTolerance) return;
   const Line2 line = Line2::Through(segment.a, segment.b);
   const Eigen::Vector2d lo = segment.a.cwiseMin(segment.b), hi = segment.a.cwiseMax(segment.b);
@@ -66,6 +66,7 @@ void SplitCells(const Segment2& segment, std::vector<Cell>* cells) {
   for (size_t i = 0; i < count; ++i) {
     Cell& cell = (*cells)[i];
     if ((cell.hi.array() < lo.array()).any() || (cell.lo.array() > hi.array()).any()) continue;
+    if ((cell.hi - cell.lo).maxCoeff() < min_cell_size) continue;
     double t0 = 0.0, t1 = 0.0;
     if (!ClipSegmentToConvex(cell.ring, segment, &t0, &t1) ||
         (t1 - t0) * segment.Length() < kPlanTolerance) {
@@ -119,8 +120,9 @@ std::vector<Cell> InitialCells(const std::vector<const AreaPart*>& parts,
 
 std::vector<Segment2> EventRays(const std::vector<Eigen::Vector2d>& points,
                                 const SegmentGrid& occluders, const std::vector<Ring2>& solids,
-                                const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
-                                double range) {
+                                const Eigen::AlignedBox2d& box, const EventRayOptions& options) {
+  const Eigen::Vector2d lo = box.min(), hi = box.max();
+  const double range = options.range;
   std::vector<Eigen::Vector2d> corners;
   for (const Ring2& solid : solids)
     corners.insert(corners.end(), solid.begin(), solid.end());
@@ -166,8 +168,15 @@ std::vector<Segment2> EventRays(const std::vector<Eigen::Vector2d>& points,
       if (!blocked) angles.push_back(std::atan2(d.y(), d.x()));
     }
     std::sort(angles.begin(), angles.end());
+    const double separation = std::max(1e-9, options.min_separation);
+    double last = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < angles.size(); ++k) {
-      if (k > 0 && angles[k] - angles[k - 1] < 1e-9) continue;
+      // The fan wraps at +-pi: the last ray is also kept clear of the first.
+      if (angles[k] - last < separation || (k + 1 == angles.size() && k > 0 &&
+                                            angles.front() + 2.0 * kPi - angles[k] < separation)) {
+        continue;
+      }
+      last = angles[k];
       const Eigen::Vector2d d(std::cos(angles[k]), std::sin(angles[k]));
       const double t_end = occluders.FirstHit(c, d, kPlanTolerance, BoxExit(c, d, lo, hi));
       if (t_end > kPlanTolerance) rays.push_back({c, c + t_end * d});

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "models/convex_polygon.h"
@@ -20,8 +21,9 @@ struct Cell {
 
 Cell MakeCell(Ring2 ring, int parent);
 
-// Splits every cell that `segment` crosses by the segment's line.
-void SplitCells(const Segment2& segment, std::vector<Cell>* cells);
+// Splits every cell that `segment` crosses by the segment's line, but no cell whose bounding box
+// is already under `min_cell_size` metres on both sides (0: every cell).
+void SplitCells(const Segment2& segment, std::vector<Cell>* cells, double min_cell_size = 0.0);
 
 // The parts' bounding box cut by the lines of their boundary edges and of the occluders, each
 // drawn only as far as it reaches before meeting a wall of `stoppers` (the occluders and the
@@ -30,12 +32,20 @@ void SplitCells(const Segment2& segment, std::vector<Cell>* cells);
 std::vector<Cell> InitialCells(const std::vector<const AreaPart*>& parts,
                                const SegmentGrid& stoppers, double grid_pitch);
 
+// Which event rays are cast: from points within `range` metres of the occluding vertex, and of
+// the rays from one vertex only those at least `min_separation` radians apart (fewer rays leave
+// coarser regions, whose lists stay conservative).
+struct EventRayOptions {
+  double range = 15.0;
+  double min_separation = 0.0;
+};
+
 // Event rays (Simsarian et al. 1996): from a vertex c of a solid (`solids`) or a free end of a
-// wall, away from a point v of `points` within `range` metres that c can start to hide (v sees c,
-// and the walls at c lie on one side of the line v-c), up to the next occluder or the box [lo, hi].
+// wall, away from a point v of `points` that c can start to hide (v sees c, and the walls at c lie
+// on one side of the line v-c), up to the next occluder or the box [lo, hi].
 std::vector<Segment2> EventRays(const std::vector<Eigen::Vector2d>& points,
                                 const SegmentGrid& occluders, const std::vector<Ring2>& solids,
-                                const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double range);
+                                const Eigen::AlignedBox2d& box, const EventRayOptions& options);
 
 // Convex pieces of the closed loops of occluders with at most `max_sides` sides that contain no
 // cell's centroid (pillars, boxes; the inside of long thick walls is left to the walls).
