@@ -23,6 +23,7 @@ void AddReplay(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 void AddMakeBuilding(CLI::App& cli, CommandAction* action);
+void AddModelImport(CLI::App& cli, CommandAction* action);
 void AddBenchBuilding(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

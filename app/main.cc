@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
   app::AddMakeBuilding(cli, &action);
+  app::AddModelImport(cli, &action);
   app::AddBenchBuilding(cli, &action);
 
   try {

@@ -12,6 +12,7 @@ packages=(
   libaravis-dev libusb-1.0-0-dev aravis-tools
   googletest libgtest-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libyaml-cpp-dev
+  libassimp-dev
 )
 
 missing=()
