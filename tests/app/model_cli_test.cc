@@ -1,6 +1,7 @@
 // Loading a model from the command line: `model-info` says what orienting the faces turned and
 // what the checks found; a finding is a warning on stderr, and under `--strict` a refusal (exit 2,
-// one line naming the file); `localize --storey` names a storey the model does not have.
+// one line naming the file); `localize --storey` names a storey the model does not have;
+// `model-import` writes the hall back from an OBJ mesh and refuses bad input without output.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "models/cao_reader.h"
 #include "models/cao_writer.h"
 #include "tests/support/cli_test.h"
+#include "tests/support/obj_export.h"
 
 namespace linetrack {
 namespace {
@@ -74,6 +76,33 @@ TEST_F(ModelCli, AStrayLineWarnsAndStrictRefuses) {
   }
   // The bundled hall passes under --strict.
   EXPECT_EQ(Linetrack("--strict model-info " + kHall + " --queries 0").code, 0);
+}
+
+TEST_F(ModelCli, ModelImportWritesTheHallBackAndRefusesBadInput) {
+  const std::string obj = (dir_ / "hall.obj").string();
+  std::ofstream(obj) << test_support::ObjMillimetresYUp(ReadCao(kHall));
+  const std::string out = (dir_ / "imported.cao").string();
+  const CommandRun run = Linetrack("model-import " + obj + " --out " + out + " --unit mm");
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("15 faces, 20 3D lines, 66 edges (28 vertical)"), std::string::npos)
+      << run.out;
+  EXPECT_TRUE(run.err.empty()) << run.err;
+  const CommandRun info = Linetrack("--strict model-info " + out + " --queries 0");
+  EXPECT_EQ(info.code, 0) << info.err;
+
+  const std::string garbage = (dir_ / "garbage.obj").string();
+  std::ofstream(garbage) << "not a model\n";
+  const std::string refused_out = (dir_ / "refused.cao").string();
+  for (const std::string& args :
+       {"model-import " + garbage + " --out " + refused_out,
+        "model-import " + (dir_ / "missing.obj").string() + " --out " + refused_out,
+        "model-import " + obj + " --out " + refused_out + " --unit inch",
+        "model-import " + obj + " --out " + refused_out + " --feature-angle 120"}) {
+    const CommandRun refused = Linetrack(args);
+    EXPECT_EQ(refused.code, 2) << args;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(refused_out)) << args;
+  }
 }
 
 TEST_F(ModelCli, LocalizeRefusesAStoreyTheModelDoesNotHave) {

@@ -6,12 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "models/errors.h"
+#include "models/geometry.h"
 #include "models/wireframe.h"
+#include "tests/support/obj_export.h"
 
 namespace linetrack {
 namespace {
@@ -93,25 +97,60 @@ TEST(MeshToCao, TriangulatedRoomGivesItsSixFaces) {
   EXPECT_EQ(WireframeModel::FromCao(cao).edges().size(), 12u);
 }
 
-// `cao` as an OBJ triangle mesh (faces fan-triangulated, 3D lines as `l`) in millimetres, y up.
-std::string ObjMillimetresYUp(const CaoModel& cao) {
-  std::ostringstream obj;
-  obj.precision(12);
-  for (const Eigen::Vector3d& p : cao.points)
-    obj << "v " << 1e3 * p.x() << " " << 1e3 * p.z() << " " << -1e3 * p.y() << "\n";
-  for (const std::vector<int>& face : cao.faces) {
-    for (size_t k = 1; k + 1 < face.size(); ++k)
-      obj << "f " << face[0] + 1 << " " << face[k] + 1 << " " << face[k + 1] + 1 << "\n";
+TEST(MeshToCao, ThinQuadInFrontOfAWallBecomesLinesOnIt) {
+  ImportMesh mesh = Room();
+  // A door leaf 1 cm in front of the wall y = 0 (inside the room), 0.9 m x 2 m.
+  const int n = static_cast<int>(mesh.points.size());
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(1.0, 0.01, 0.0), Eigen::Vector3d(1.9, 0.01, 0.0),
+        Eigen::Vector3d(1.9, 0.01, 2.0), Eigen::Vector3d(1.0, 0.01, 2.0)})
+    mesh.points.push_back(p);
+  mesh.triangles.push_back({n, n + 1, n + 2});
+  mesh.triangles.push_back({n, n + 2, n + 3});
+  MeshToCaoSummary summary;
+  const CaoModel cao = MeshToCao(mesh, {}, "room with door", &summary);
+  EXPECT_EQ(summary.openings, 1);
+  EXPECT_EQ(cao.faces.size(), 6u);
+  ASSERT_EQ(cao.lines.size(), 4u);
+  for (const std::array<int, 2>& line : cao.lines) {
+    for (int end : line)
+      EXPECT_NEAR(cao.points[end].y(), 0.0, kPointTolM) << "on the wall y = 0";
   }
-  for (const std::array<int, 2>& line : cao.lines)
-    obj << "l " << line[0] + 1 << " " << line[1] + 1 << "\n";
-  return obj.str();
+}
+
+TEST(MeshToCao, CurvedSurfaceKeepsItsOutlineNotItsFacets) {
+  // A round pillar, radius 0.2 m, 2.5 m high: 24 side facets (15 degrees apart) and two caps.
+  constexpr int kSides = 24;
+  ImportMesh mesh;
+  for (int k = 0; k < kSides; ++k) {
+    const double a = 2.0 * kPi * k / kSides;
+    mesh.points.emplace_back(0.2 * std::cos(a), 0.2 * std::sin(a), 0.0);
+    mesh.points.emplace_back(0.2 * std::cos(a), 0.2 * std::sin(a), 2.5);
+  }
+  for (int k = 0; k < kSides; ++k) {
+    const int a = 2 * k, b = 2 * ((k + 1) % kSides);
+    mesh.triangles.push_back({a, b, b + 1});
+    mesh.triangles.push_back({a, b + 1, a + 1});
+    if (k > 0 && k + 1 < kSides) {
+      mesh.triangles.push_back({0, b, a});          // bottom cap, a fan
+      mesh.triangles.push_back({1, a + 1, b + 1});  // top cap
+    }
+  }
+  MeshToCaoSummary summary;
+  const CaoModel cao = MeshToCao(mesh, {}, "pillar", &summary);
+  EXPECT_EQ(summary.curved_facets, kSides);
+  EXPECT_EQ(cao.faces.size(), 2u);  // the caps
+  EXPECT_EQ(cao.lines.size(), 0u);  // the rims are the caps' edges; no vertical facet edge
+  const WireframeModel model = WireframeModel::FromCao(cao);
+  EXPECT_EQ(model.edges().size(), 2u * kSides);
+  EXPECT_TRUE(std::none_of(model.edges().begin(), model.edges().end(),
+                           [](const ModelEdge& e) { return e.vertical; }));
 }
 
 TEST(ModelImport, HallRoundTripThroughObjInMillimetresYUp) {
   const std::string hall_path = kSource + "/models/hall.cao";
   const CaoModel hall = ReadCao(hall_path);
-  const std::string obj = Write("hall.obj", ObjMillimetresYUp(hall));
+  const std::string obj = Write("hall.obj", test_support::ObjMillimetresYUp(hall));
   ModelImportOptions options;
   options.metres_per_unit = 1e-3;
   const ImportedModel imported = ImportModel(obj, options);
