@@ -40,6 +40,16 @@ struct Matcher {
         localizer(model, &regions, &area, PaperSyntheticCamera()) {}
 };
 
+// kScenes seeded synthetic scenes of `m` with the paper's QI2 priors.
+std::vector<SyntheticScene> Qi2Scenes(const Matcher& m) {
+  SyntheticSceneOptions options;
+  options.count = kScenes;
+  const PriorBounds qi2 = QualityIndexBounds(2);
+  options.delta_t = qi2.delta_t;
+  options.delta_phi = qi2.delta_phi;
+  return GenerateScenes(m.model, m.area, options);
+}
+
 class Equivalence : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(Equivalence, ReversedFacesLocaliseExactlyAsWritten) {
@@ -47,13 +57,8 @@ TEST_P(Equivalence, ReversedFacesLocaliseExactlyAsWritten) {
   const Matcher written(cao);
   const Matcher all_reversed(test_support::ReversedFaces(cao, 1.0, 0u));
   const Matcher half_reversed(test_support::ReversedFaces(cao, 0.5, 3u));
-  SyntheticSceneOptions options;
-  options.count = kScenes;
-  const PriorBounds qi2 = QualityIndexBounds(2);
-  options.delta_t = qi2.delta_t;
-  options.delta_phi = qi2.delta_phi;
   int found = 0;
-  for (const SyntheticScene& scene : GenerateScenes(written.model, written.area, options)) {
+  for (const SyntheticScene& scene : Qi2Scenes(written)) {
     const LocalizationResult a = written.localizer.Localize(ProblemOf(scene));
     found += a.found ? 1 : 0;
     for (const Matcher* other : {&all_reversed, &half_reversed}) {
@@ -79,13 +84,8 @@ TEST(ImportedModel, LocalisesAsTheHandWrittenOne) {
   const Matcher written(cao);
   const Matcher imported(ImportModel(obj, import).cao);
   std::filesystem::remove(obj);
-  SyntheticSceneOptions options;
-  options.count = kScenes;
-  const PriorBounds qi2 = QualityIndexBounds(2);
-  options.delta_t = qi2.delta_t;
-  options.delta_phi = qi2.delta_phi;
   int found = 0;
-  for (const SyntheticScene& scene : GenerateScenes(written.model, written.area, options)) {
+  for (const SyntheticScene& scene : Qi2Scenes(written)) {
     const LocalizationResult a = written.localizer.Localize(ProblemOf(scene));
     const LocalizationResult b = imported.localizer.Localize(ProblemOf(scene));
     found += a.found ? 1 : 0;
