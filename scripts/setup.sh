@@ -13,6 +13,7 @@ packages=(
   googletest libgtest-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libyaml-cpp-dev
   libassimp-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()
