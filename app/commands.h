@@ -26,5 +26,8 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 void AddCalibrateMount(CLI::App& cli, CommandAction* action);
+void AddMakeBuilding(CLI::App& cli, CommandAction* action);
+void AddModelImport(CLI::App& cli, CommandAction* action);
+void AddBenchBuilding(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

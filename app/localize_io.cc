@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/cli_common.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace linetrack::app {
@@ -118,9 +119,26 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
   if (c.problem.height <= 0.0) {
     throw InputError("key \"height\" is not a camera height (metres above the floor, > 0)");
   }
+  if (json.contains("storey")) {
+    if (!json["storey"].is_number_integer() || json["storey"].get<int>() < 0) {
+      throw InputError("key \"storey\" must be an integer >= 0");
+    }
+    c.storey = json["storey"].get<int>();
+  }
+  if (json.contains("floor_z")) c.floor_z = FiniteNumber(json, "floor_z");
   c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
   CheckProblem(c.problem);
   return c;
+}
+
+double CameraZ(const WireframeModel& model, double height, int storey, double floor_z) {
+  if (std::isfinite(floor_z)) return floor_z + height;
+  const int s = std::max(storey, 0);
+  if (s >= static_cast<int>(model.storeys().size())) {
+    throw InputError("storey " + std::to_string(s) + ": " + model.path() + " has " +
+                     std::to_string(model.storeys().size()) + " storeys (0 is the lowest)");
+  }
+  return model.storeys()[s].floor_z + height;
 }
 
 nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const LocalizationResult& result,
@@ -167,9 +185,7 @@ const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
   auto it = models_.find(model_path);
   if (it != models_.end()) return it->second;
   LoadedModel loaded;
-  loaded.model = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
-  for (const std::string& w : loaded.model->warnings())
-    spdlog::warn("{}", w);
+  loaded.model = std::make_unique<WireframeModel>(LoadModel(model_path));
   try {
     loaded.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*loaded.model));
     loaded.regions = std::make_unique<ViewInvariantRegions>(

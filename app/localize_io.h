@@ -2,6 +2,7 @@
 // JSON, plus a cache that loads each model and camera once.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -23,12 +24,20 @@ struct BatchCase {
   std::string model_path;  // resolved against the batch file's folder
   std::string camera_path;
   std::string camera_name;  // optional "camera_name" key
-  LocalizationProblem problem;
+  // Which floor "height" is measured from: the optional "storey" key (an index into the model's
+  // storeys; -1: not given, storey 0) or "floor_z" (world z, metres; NaN: not given).
+  int storey = -1;
+  double floor_z = std::numeric_limits<double>::quiet_NaN();
+  LocalizationProblem problem;  // problem.height: above that floor until CameraZ() is applied
 };
 
 // Parses one JSON line of a batch file; relative paths are resolved against `base_dir`.
 // Throws InputError naming the missing or malformed key.
 BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir);
+
+// World z of a camera `height` metres above the floor of `storey` (-1: storey 0) of `model`, or
+// above `floor_z` when finite. Throws InputError when the storey does not exist.
+double CameraZ(const WireframeModel& model, double height, int storey, double floor_z);
 
 // The result of one case as a JSON object: id (as given), found, pose, cMo, matches ([edge,
 // line] pairs), score, hypotheses, time_ms (and diagnostics: candidate_edges, tree_nodes,

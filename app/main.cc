@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/ros/bag_recording.h"
 #include "app/ros/ros_commands.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace {
@@ -40,11 +41,14 @@ int main(int argc, char** argv) {
       "linetrack"};
   cli.set_version_flag("--version", VersionText(), "Print the version and exit");
   cli.require_subcommand(1);
-  // Global flags (-q) are accepted after the subcommand too: its subcommands (inheriting this)
-  // hand the options they do not know up to here.
+  // Global flags (--quiet, --strict) are accepted after the subcommand too: its subcommands
+  // (inheriting this) hand the options they do not know up to here.
   cli.fallthrough(true);
   bool quiet = false;
   cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
+  bool strict = false;
+  cli.add_flag("--strict", strict,
+               "Refuse a model the checks find fault with (exit 2) instead of warning");
 
   app::CommandAction action;
   app::AddModelInfo(cli, &action);
@@ -66,6 +70,9 @@ int main(int argc, char** argv) {
   app::AddRos(cli, &action);
   app::AddBenchRos(cli, &action);
   app::AddCalibrateMount(cli, &action);
+  app::AddMakeBuilding(cli, &action);
+  app::AddModelImport(cli, &action);
+  app::AddBenchBuilding(cli, &action);
 
   try {
     cli.parse(argc, argv);
@@ -75,6 +82,7 @@ int main(int argc, char** argv) {
     return app::kExitBadInput;
   }
   if (quiet) spdlog::set_level(spdlog::level::err);
+  app::SetStrictModelChecks(strict);
   try {
     return action ? action() : app::kExitBadInput;
   } catch (const InputError& e) {

@@ -84,13 +84,19 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
     std::iota(all.begin(), all.end(), 0);
     return all;
   }
+  return regions_->Query(VisibilityQueryOf(problem, camera_));
+}
+
+VisibilityQuery VisibilityQueryOf(const LocalizationProblem& problem,
+                                  const CameraIntrinsics& camera) {
   VisibilityQuery query;
   query.centre = {problem.prior.x, problem.prior.y};
   query.radius = problem.delta_t;
   query.heading = problem.prior.heading;
   query.heading_margin = problem.delta_phi;
-  query.bearing_half_width = BearingHalfWidth(camera_, problem.tilt, problem.tilt);
-  return regions_->Query(query);
+  query.bearing_half_width = BearingHalfWidth(camera, problem.tilt, problem.tilt);
+  query.camera_z = problem.height;
+  return query;
 }
 
 namespace {
@@ -428,6 +434,14 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   LocalizationResult result;
   const std::vector<int> ids = CandidateEdges(problem);
   result.candidate_edges = static_cast<int>(ids.size());
+  if (ids.empty()) {
+    result.reason = "no candidate edge: " +
+                    (regions_ != nullptr && !problem.candidate_edges
+                         ? regions_->ExplainEmptyQuery(VisibilityQueryOf(problem, camera_))
+                         : std::string(problem.candidate_edges ? "the given list is empty"
+                                                               : "the model has no edges"));
+    return result;
+  }
   const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
   const std::vector<ObservedLine> lines = PrepareLines(
       problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);

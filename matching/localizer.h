@@ -59,7 +59,7 @@ struct LocalizationProblem {
   Pose3Dof prior;          // x, y (metres), heading (radians)
   double delta_t = 0.0;    // prior position bound (metres)
   double delta_phi = 0.0;  // prior heading bound (radians)
-  double height = 0.0;     // camera height (metres)
+  double height = 0.0;     // camera height: world z of the optical centre (metres)
   double tilt = 0.0;       // camera tilt (radians, positive down)
   // When set, these model edge ids are the candidates instead of the view-invariant regions'
   // answer (e.g. a tracker that knows which edges it sees).
@@ -150,5 +150,10 @@ class Localizer {
 
 // Throws InputError naming the field when the problem is malformed.
 void CheckProblem(const LocalizationProblem& problem);
+
+// The view-invariant regions' question for a problem's prior: its disk and heading interval, the
+// image's bearing half-width at its tilt, the camera's height (world z, which picks the storey).
+VisibilityQuery VisibilityQueryOf(const LocalizationProblem& problem,
+                                  const CameraIntrinsics& camera);
 
 }  // namespace linetrack

@@ -8,6 +8,8 @@
 #include <utility>
 
 #include "models/errors.h"
+#include "models/face_orientation.h"
+#include "models/free_space.h"
 
 namespace linetrack {
 namespace {
@@ -101,6 +103,29 @@ std::string JoinedNames(const std::vector<std::string>& names) {
   return joined;
 }
 
+// The faces of `cao` on the merged vertices, with their planes and names; counts those without
+// area.
+std::vector<ModelFace> BuildFaces(const CaoModel& cao, const std::vector<int>& vertex_of_point,
+                                  const std::vector<Eigen::Vector3d>& vertices, int* degenerate) {
+  std::vector<ModelFace> faces;
+  for (size_t f = 0; f < cao.faces.size(); ++f) {
+    std::vector<int> ids;
+    for (int p : cao.faces[f])
+      ids.push_back(vertex_of_point[p]);
+    faces.push_back(MakeFace(ids, vertices, NameAt(cao.face_names, f)));
+    *degenerate += faces.back().Degenerate() ? 1 : 0;
+  }
+  return faces;
+}
+
+void Flip(ModelFace* face) {
+  std::reverse(face->vertices.begin(), face->vertices.end());
+  std::reverse(face->corners.begin(), face->corners.end());
+  face->normal = -face->normal;
+  face->offset = -face->offset;
+  face->flipped = !face->flipped;
+}
+
 }  // namespace
 
 bool WireframeOptions::Check(std::string* why) const {
@@ -137,12 +162,27 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     }
   }
 
+  int degenerate_faces = 0;
+  model.faces_ = BuildFaces(cao, vertex_of_point, model.vertices_, &degenerate_faces);
+  model.storeys_ = DetectStoreys(model.faces_, model.box_min_.z(), model.box_max_.z());
+  if (options.orient_faces) {
+    const std::vector<FaceOrientation> orientation = OrientFaces(model);
+    model.oriented_ = !orientation.empty();
+    for (size_t f = 0; f < orientation.size(); ++f) {
+      if (orientation[f].flip) Flip(&model.faces_[f]);
+      model.faces_[f].two_sided = orientation[f].rule == OrientationRule::kTwoSided;
+      model.faces_[f].one_sided = orientation[f].rule == OrientationRule::kFreeSide ||
+                                  orientation[f].rule == OrientationRule::kOutsideSide;
+    }
+    model.orientation_summary_ = OrientationSummary(model, orientation);
+  }
+
+  // Edges after orientation: a face's edges are numbered in its (oriented) point order.
   const double cos_vertical = std::cos(DegToRad(options.vertical_tolerance_deg));
   std::map<std::pair<int, int>, int> edge_of_vertices;
   int degenerate = 0;
   std::vector<std::vector<std::string>> face_names_of_edge;  // per edge, the named faces it borders
-  auto add_edge = [&](int p0, int p1, bool from_line, int face, const std::string& name) {
-    const int v0 = vertex_of_point[p0], v1 = vertex_of_point[p1];
+  auto add_edge = [&](int v0, int v1, bool from_line, int face, const std::string& name) {
     if (v0 == v1) {
       ++degenerate;
       return;
@@ -166,15 +206,15 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     face_names_of_edge.emplace_back();
     if (face >= 0) face_names_of_edge.back().push_back(name);
   };
-
   for (size_t l = 0; l < cao.lines.size(); ++l) {
-    add_edge(cao.lines[l][0], cao.lines[l][1], true, -1, NameAt(cao.line_names, l));
+    add_edge(vertex_of_point[cao.lines[l][0]], vertex_of_point[cao.lines[l][1]], true, -1,
+             NameAt(cao.line_names, l));
   }
-  for (size_t f = 0; f < cao.faces.size(); ++f) {
-    const std::vector<int>& face = cao.faces[f];
+  for (size_t f = 0; f < model.faces_.size(); ++f) {
+    const std::vector<int>& face = model.faces_[f].vertices;
     for (size_t i = 0; i < face.size(); ++i) {
       add_edge(face[i], face[(i + 1) % face.size()], false, static_cast<int>(f),
-               NameAt(cao.face_names, f));
+               model.faces_[f].name);
     }
   }
   for (ModelEdge& edge : model.edges_) {
@@ -183,15 +223,6 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
   if (degenerate > 0) {
     model.warnings_.push_back(
         Located(model.path_, 0, std::to_string(degenerate) + " zero-length edges skipped"));
-  }
-
-  int degenerate_faces = 0;
-  for (size_t f = 0; f < cao.faces.size(); ++f) {
-    std::vector<int> vertices;
-    for (int p : cao.faces[f])
-      vertices.push_back(vertex_of_point[p]);
-    model.faces_.push_back(MakeFace(vertices, model.vertices_, NameAt(cao.face_names, f)));
-    degenerate_faces += model.faces_.back().Degenerate() ? 1 : 0;
   }
   if (degenerate_faces > 0) {
     model.warnings_.push_back(

@@ -15,6 +15,8 @@ packages=(
   ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-geometry-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
   libimage-transport-dev libcv-bridge-dev libdiagnostic-updater-dev
+  libassimp-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -18,6 +18,7 @@
 
 #include "app/commands.h"
 #include "app/image_overlay.h"
+#include "app/model_loading.h"
 #include "app/rendered_cases.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -215,7 +216,7 @@ int RunBenchLines(const BenchLinesOptions& opt) {
     detectors.push_back(*kind);
   }
   cv::setNumThreads(1);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const OcclusionTester occlusion(model);
 

@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/localize_image.h"
 #include "app/match_outcome.h"
+#include "app/model_loading.h"
 #include "app/rendered_cases.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -223,7 +224,7 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   if (!detector) throw InputError("--detector: unknown detector '" + opt.detector + "'");
   const PriorBounds bounds = QualityIndexBounds(opt.qi);
   cv::setNumThreads(1);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
   const OcclusionTester occlusion(model);

@@ -15,6 +15,7 @@
 
 #include "app/commands.h"
 #include "app/match_outcome.h"
+#include "app/model_loading.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
@@ -75,11 +76,7 @@ PoseErrors AnswerErrors(const SyntheticScene& scene, const LocalizationResult& r
 
 Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result,
               const PoseErrors& errors) {
-  const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
-  const bool all_true =
-      !result.matches.empty() && std::all_of(result.matches.begin(), result.matches.end(),
-                                             [&](const auto& m) { return truth.count(m) > 0; });
-  return JudgeMatch(result.found, all_true, errors);
+  return JudgeMatch(result.found, ReportedMatchesTrue(scene.matches, result.matches), errors);
 }
 
 Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, double ms,
@@ -306,7 +303,7 @@ SyntheticSceneOptions SceneOptions(const BenchMatchOptions& opt, const Series& s
 }
 
 int RunBenchMatch(const BenchMatchOptions& opt) {
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
   std::vector<Series> series;

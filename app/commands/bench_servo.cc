@@ -10,6 +10,7 @@
 #include "app/bench/servo_bench.h"
 #include "app/commands.h"
 #include "app/localize_image.h"
+#include "app/model_loading.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -74,7 +75,7 @@ int RunBenchServo(BenchServoCommandOptions opt) {
   const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   NavigableAreaOptions area_options;
   area_options.sidecar_path = opt.nav_path;
   const NavigableArea area = NavigableArea::FromModel(model, area_options);

@@ -23,6 +23,7 @@
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
+#include "app/model_loading.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -207,9 +208,7 @@ nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop
 class LiveFiles {
  public:
   LiveFiles(const LiveCommandOptions& opt, const LivePlan& plan)
-      : camera_(ReadLiveCamera(opt.camera_path)), model_(WireframeModel::Load(opt.model_path)) {
-    for (const std::string& w : model_.warnings())
-      spdlog::warn("{}", w);
+      : camera_(ReadLiveCamera(opt.camera_path)), model_(LoadModel(opt.model_path)) {
     inputs_.camera = camera_;
     inputs_.model = &model_;
     if (!opt.prior_file.empty()) inputs_.priors = ReadPriors(opt.prior_file);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "app/commands.h"
@@ -30,6 +31,8 @@ struct LocalizeOptions {
   double delta_t = SearchBounds().delta_t;
   double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
   double height = 0.0, tilt_deg = 0.0;
+  int storey = -1;
+  double floor_z = std::numeric_limits<double>::quiet_NaN();
   std::string method = "tree";
   bool json = false;
   // From an image (--image) instead of --lines: the line extractor's flags and an overlay.
@@ -126,6 +129,7 @@ int RunBatch(const LocalizeOptions& opt) {
       if (json.is_object() && json.contains("id")) id = json["id"];
       BatchCase c = ParseBatchCase(json, base_dir);
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
+      c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
       const auto start = std::chrono::steady_clock::now();
       const LocalizationResult result = localizer.Localize(c.problem);
       const double ms = Milliseconds(start);
@@ -198,6 +202,7 @@ int RunSingle(const LocalizeOptions& opt) {
   const IntegrityOptions integrity_options = opt.integrity.Options();
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
+  problem.height = CameraZ(localizer.model(), opt.height, opt.storey, opt.floor_z);
   const auto start = std::chrono::steady_clock::now();
   LocalizationResult result;
   if (problem.lines.empty()) {
@@ -283,6 +288,12 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)")
       ->capture_default_str();
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
+  cmd->add_option("--storey", opt->storey,
+                  "The storey the camera stands on (0 the lowest, default); --height is above "
+                  "its floor")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--floor-z", opt->floor_z,
+                  "World z of the floor the camera stands on (metres), instead of --storey");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
   cmd->add_flag("--json", opt->json, "Print the result as JSON (the batch format)");
   AddIntegrityFlags(cmd, &opt->integrity);
@@ -292,10 +303,11 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       ->check(CLI::IsMember({"tree", "baseline"}));
   cmd->callback([opt, action, cmd] {
     const bool batch = !opt->batch_path.empty();
-    RefuseUnless(*cmd, !batch,
-                 {"--model", "--camera", "--camera-name", "--lines", "--image", "--overlay",
-                  "--prior", "--delta-t", "--delta-phi", "--height", "--tilt", "--json"},
-                 "not with --batch (each case of the batch gives its own)");
+    RefuseUnless(
+        *cmd, !batch,
+        {"--model", "--camera", "--camera-name", "--lines", "--image", "--overlay", "--prior",
+         "--delta-t", "--delta-phi", "--height", "--storey", "--floor-z", "--tilt", "--json"},
+        "not with --batch (each case of the batch gives its own)");
     RefuseUnless(*cmd, cmd->count("--image") > 0,
                  {"--overlay", "--detector", "--min-length", "--roi", "--no-merge", "--undistort"},
                  "applies to the lines extracted from an --image");

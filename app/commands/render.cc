@@ -16,6 +16,7 @@
 #include <set>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "app/render_sequence.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -166,9 +167,7 @@ int RunRender(RenderCommandOptions opt) {
   const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
-  for (const std::string& w : model.warnings())
-    spdlog::warn("{}", w);
+  const WireframeModel model = LoadModel(opt.model_path);
   std::optional<NavigableArea> area;
   if (opt.clutter > 0 || (form & kGenerated) != 0 || opt.sequence.effects.people > 0) {
     NavigableAreaOptions area_options;

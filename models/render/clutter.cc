@@ -46,12 +46,7 @@ struct Aabb {
 };
 
 bool FreeAt(const NavigableArea& area, const Eigen::Vector3d& p) {
-  const Eigen::Vector2d q = p.head<2>();
-  if (!area.outer().Contains(q)) return false;
-  for (const Polygon2& hole : area.holes()) {
-    if (hole.Contains(q)) return false;
-  }
-  return true;
+  return area.InsideBoundary(p.head<2>());
 }
 
 RenderSurface Solid(std::vector<Eigen::Vector3d> polygon, double albedo, bool decal = false) {

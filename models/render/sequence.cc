@@ -29,9 +29,11 @@ std::vector<Segment2> Obstacles(const NavigableArea& area) {
       out.push_back({ring.vertices[i], ring.vertices[(i + 1) % ring.vertices.size()]});
     }
   };
-  add_ring(area.outer());
-  for (const Polygon2& hole : area.holes())
-    add_ring(hole);
+  for (const AreaPart& part : area.parts()) {
+    add_ring(part.outer);
+    for (const Polygon2& hole : part.holes)
+      add_ring(hole);
+  }
   return out;
 }
 

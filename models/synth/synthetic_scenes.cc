@@ -29,11 +29,11 @@ CameraIntrinsics ImageCamera(const CameraIntrinsics& nominal, double calibration
   return camera;
 }
 
-Eigen::Vector2d RandomPosition(const NavigableArea& area, SceneRandom* rng) {
-  const Eigen::Vector2d lo = area.BoundsMin(), hi = area.BoundsMax();
+Eigen::Vector2d RandomPosition(const NavigableArea& area, int storey, SceneRandom* rng) {
+  const Eigen::Vector2d lo = area.BoundsMin(storey), hi = area.BoundsMax(storey);
   for (int i = 0; i < kMaxPositionDraws; ++i) {
     const Eigen::Vector2d p(rng->Uniform(lo.x(), hi.x()), rng->Uniform(lo.y(), hi.y()));
-    if (area.Contains(p)) return p;
+    if (area.Contains(p, storey)) return p;
   }
   throw InputError(area.source() + ": no position of the navigable area found by sampling");
 }
@@ -80,8 +80,8 @@ std::optional<Segment2> VerticalClutterLine(const RobotPose& truth, const Camera
     const double top = rng->Uniform(o.vertical_clutter_height_min, o.vertical_clutter_height_max);
     const Eigen::Vector2d foot = Eigen::Vector2d(truth.x, truth.y) +
                                  distance * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
-    if (!area.InsideWalls(foot, kClutterWallMarginM)) continue;
-    Segment3 segment{{foot.x(), foot.y(), 0.0}, {foot.x(), foot.y(), top}};
+    if (!area.InsideWalls(foot, kClutterWallMarginM, o.storey)) continue;
+    Segment3 segment{{foot.x(), foot.y(), o.floor_z}, {foot.x(), foot.y(), o.floor_z + top}};
     if (!ClipToFrustum(cam_from_world, camera, EdgeProjectionOptions().near_clip, &segment) ||
         occlusion.Blocked(truth.Centre(), segment.a) ||
         occlusion.Blocked(truth.Centre(), segment.b)) {
@@ -196,11 +196,11 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
                        " draws sees " + std::to_string(o.min_visible_edges) + " to " +
                        std::to_string(o.max_visible_edges) + " model edges");
     }
-    const Eigen::Vector2d position = RandomPosition(area, &rng);
+    const Eigen::Vector2d position = RandomPosition(area, o.storey, &rng);
     scene.truth.x = position.x();
     scene.truth.y = position.y();
     scene.truth.heading = rng.Uniform(-kPi, kPi);
-    scene.truth.height = rng.Uniform(o.height_min, o.height_max);
+    scene.truth.height = o.floor_z + rng.Uniform(o.height_min, o.height_max);
     scene.truth.tilt = rng.Uniform(o.tilt_min, o.tilt_max);
     scene.calibration_error = rng.Normal(o.calibration_sigma);
     camera = ImageCamera(o.camera, scene.calibration_error);

@@ -12,6 +12,13 @@
 #include <limits>
 #include <sstream>
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include "models/cao_reader.h"
+#include "models/cao_writer.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/wireframe.h"
@@ -85,6 +92,34 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
   }
 }
 
+void LoadOrientedVispModel(const CaoModel& cao, const WireframeModel& model,
+                           vpMbGenericTracker* tracker) {
+  if (!model.oriented()) {
+    LoadVispModel(model.path(), tracker);
+    return;
+  }
+  // ViSP reads models from files only: a private temporary file, removed once read.
+  std::string path =
+      (std::filesystem::temp_directory_path() / "linetrack-oriented-XXXXXX.cao").string();
+  const int fd = mkstemps(path.data(), 4);
+  if (fd < 0)
+    throw InputError(Located(model.path(), 0, "cannot write the oriented model for ViSP"));
+  close(fd);
+  struct Remove {
+    std::string path;
+    ~Remove() {
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+    }
+  } remove{path};
+  std::ofstream(path) << CaoText(OrientedCao(cao, model), model.path() + ", faces oriented");
+  try {
+    LoadVispModel(path, tracker);
+  } catch (const InputError& e) {
+    throw InputError(Located(model.path(), 0, std::string("oriented copy: ") + e.what()));
+  }
+}
+
 void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsics& camera,
                           vpMbGenericTracker* tracker) {
   std::string why;
@@ -125,8 +160,9 @@ EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& 
   if (camera_.width <= 0 || camera_.height <= 0) {
     throw InputError("camera '" + camera_.name + "': the image size is needed to track");
   }
-  LoadVispModel(model_path, tracker_.get());
-  model_ = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  const CaoModel cao = ReadCao(model_path);
+  model_ = std::make_unique<WireframeModel>(WireframeModel::FromCao(cao));
+  LoadOrientedVispModel(cao, *model_, tracker_.get());
   occlusion_ = std::make_unique<OcclusionTester>(*model_);
   for (const ModelEdge& edge : model_->edges())
     edges_.push_back(edge.segment);

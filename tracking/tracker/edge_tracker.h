@@ -48,10 +48,10 @@ double RmsImageMotionPx(const std::vector<Segment3>& edges, const CameraIntrinsi
 
 class EdgeTracker {
  public:
-  // Loads the .cao model through ViSP (and linetrack's reader, for the edges the sub-pixel
-  // refinement uses) and applies `settings` and the (undistorted) camera, whose image size must
-  // be known. Throws InputError naming the model when it cannot be loaded, or naming the settings'
-  // source when they are invalid.
+  // Reads the .cao model (linetrack's reader orients its faces), hands ViSP the oriented model
+  // (LoadOrientedVispModel) and applies `settings` and the (undistorted) camera, whose image size
+  // must be known. Throws InputError naming the model when it cannot be loaded, or naming the
+  // settings' source when they are invalid.
   EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
               const TrackerSettings& settings);
   ~EdgeTracker();
@@ -120,6 +120,12 @@ void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsic
 // Loads a .cao model into a ViSP tracker without ViSP's console output. Throws InputError naming
 // the file when ViSP cannot load it.
 void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker);
+
+// Loads `model` (built from `cao`) into a ViSP tracker with its faces as linetrack oriented them
+// (through a temporary .cao file, models/cao_writer.h); an object left as written loads from its
+// own file. Throws InputError naming the model when ViSP cannot load it.
+void LoadOrientedVispModel(const CaoModel& cao, const WireframeModel& model,
+                           vpMbGenericTracker* tracker);
 
 // Why ViSP's tracker failed, in the user's terms. ViSP's "not enough moving edges ... Try to reduce
 // the threshold=R using setGoodMovingEdgesRatioThreshold()" names an API call; this says what
