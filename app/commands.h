@@ -23,5 +23,6 @@ void AddReplay(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 void AddCalibrateMount(CLI::App& cli, CommandAction* action);
+void AddBenchMount(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

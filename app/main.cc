@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
   app::AddCalibrateMount(cli, &action);
+  app::AddBenchMount(cli, &action);
 
   try {
     cli.parse(argc, argv);
