@@ -29,5 +29,6 @@ void AddCalibrateMount(CLI::App& cli, CommandAction* action);
 void AddMakeBuilding(CLI::App& cli, CommandAction* action);
 void AddModelImport(CLI::App& cli, CommandAction* action);
 void AddBenchBuilding(CLI::App& cli, CommandAction* action);
+void AddBenchMount(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -73,6 +73,7 @@ int main(int argc, char** argv) {
   app::AddMakeBuilding(cli, &action);
   app::AddModelImport(cli, &action);
   app::AddBenchBuilding(cli, &action);
+  app::AddBenchMount(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -20,6 +20,7 @@ endfunction()
 function(linetrack_unity_build_exceptions)
   set(skips
       linetrack_models models/view_invariant_regions.cc
+      linetrack_models models/face_orientation.cc
       linetrack_render models/render/sequence.cc
       linetrack_tracking tracking/tracker/relocalizer.cc
       linetrack_tracking tracking/tracker/sequence_tracker.cc

@@ -221,5 +221,22 @@ TEST_F(CalibrateMountCli, LiveOnTheSimulatorWithItsBracketOffThenLiveUsesTheMoun
   EXPECT_NE(summary["mount"].get<std::string>().find("calibrated mount"), std::string::npos);
 }
 
+// `bench mount`: one seeded run of the live mode on the simulator, judged against its truth by the
+// bench itself; a bad count of runs is refused.
+TEST_F(CalibrateMountCli, BenchMountReportsTheErrorsOfASeededRun) {
+  const std::string camera = " --camera " + kSource + "/tests/data/camera_wide.xml";
+  ExpectBadInput(Linetrack("bench mount" + camera + " --seeds 0"), "--seeds");
+  const CommandRun run = Linetrack("-q bench mount" + camera + " --seeds 1 --first-seed 3 --json");
+  ASSERT_EQ(run.code, 0) << run.err << run.out;
+  const nlohmann::json runs = nlohmann::json::parse(run.out);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0]["seed"].get<int>(), 3);
+  EXPECT_TRUE(runs[0]["ok"].get<bool>());
+  EXPECT_GT(runs[0]["bracket_mm"].get<double>(), 0.0);
+  EXPECT_LT(runs[0]["position_error_mm"].get<double>(), 1e3 * kSimPositionTolM);
+  EXPECT_LT(runs[0]["rotation_error_deg"].get<double>(), kSimRotationTolDeg);
+  EXPECT_GT(runs[0]["nees"].get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace linetrack
