@@ -4,39 +4,6 @@
 # imported targets, so -Werror does not trip on them).
 function(linetrack_strict_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
-  # A unity build (CMAKE_UNITY_BUILD, scripts/test.sh) compiles several sources as one; GCC then
-  # takes a class of one source using another's anonymous-namespace type for a linkage hazard.
-  if(CMAKE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
-    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
-  endif()
-endfunction()
-
-# Unity builds (scripts/test.sh sets CMAKE_UNITY_BUILD): a library's sources are compiled in
-# batches, so the heavy headers (ViSP, OpenCV, Eigen, CLI11, spdlog, JSON) are parsed and their
-# templates compiled once per batch. Sources whose file-local helpers (anonymous namespace) share
-# a name with another source's of the same library are compiled on their own; a new clash shows
-# as a redefinition error in the unity build only: add its source here (or rename the helper).
-# The tests are not unity-built: their files share many constant names (kTol, kScenes, ...).
-function(linetrack_unity_build_exceptions)
-  set(skips
-      linetrack_models models/view_invariant_regions.cc
-      linetrack_models models/face_orientation.cc
-      linetrack_render models/render/sequence.cc
-      linetrack_tracking tracking/tracker/relocalizer.cc
-      linetrack_tracking tracking/tracker/sequence_tracker.cc
-      linetrack_tracking tracking/tracker/edge_refinement.cc
-      linetrack_tracking tracking/live/live_loop.cc
-      linetrack_app app/commands/localize.cc
-      linetrack_app app/commands/replay.cc
-      linetrack_app app/commands/bench_servo.cc
-      linetrack_app app/commands/bench_match.cc
-      linetrack_app app/commands/bench_lines.cc
-      linetrack_app app/replay_output.cc)
-  while(skips)
-    list(POP_FRONT skips target source)
-    set_source_files_properties(${LINETRACK_SOURCE_DIR}/${source} TARGET_DIRECTORY ${target}
-                                PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
-  endwhile()
 endfunction()
 
 # linetrack_add_library(NAME linetrack_models SRCS a.cc b.cc PUBLIC_LINK ... PRIVATE_LINK ...)
@@ -58,7 +25,6 @@ endfunction()
 function(linetrack_add_test)
   cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK;PROPERTIES;SUITES" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
-  set_target_properties(${ARG_NAME} PROPERTIES UNITY_BUILD OFF)  # see linetrack_unity_build_exceptions
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
   target_include_directories(${ARG_NAME} PRIVATE ${LINETRACK_SOURCE_DIR})  # tests/support/
   target_compile_definitions(${ARG_NAME} PRIVATE
