@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/ground_truth.h"
 #include "app/head_mount.h"
 #include "app/integrity_output.h"
 #include "app/line_flags.h"
@@ -61,46 +62,6 @@ bool IsRecording(const std::string& input) {
 double Milliseconds(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
-
-// Ground truth: a TUM file (by time) or a printf pattern of ViSP pose files (by frame number).
-class GroundTruth {
- public:
-  explicit GroundTruth(const std::string& spec) : spec_(spec) {
-    if (spec.empty()) return;
-    if (ParseSequencePattern(spec, &pattern_)) {
-      long first = 0, last = 0;
-      if (!FindSequenceRange(pattern_, &first, &last)) {
-        throw InputError(spec + ": --ground-truth: no pose file matches the pattern");
-      }
-      by_frame_ = true;
-    } else {
-      poses_ = ReadTum(spec);
-      if (poses_.empty()) throw InputError(spec + ": --ground-truth: no poses");
-    }
-  }
-  bool enabled() const { return !spec_.empty(); }
-  std::vector<double> Times() const {
-    std::vector<double> times;
-    for (const StampedPose& p : poses_)
-      times.push_back(p.t);
-    return times;
-  }
-  // cam_from_world of frame `frame` taken at `t`; tolerance in seconds for TUM files.
-  std::optional<Eigen::Isometry3d> At(long frame, double t, double tolerance) const {
-    if (!by_frame_) return GroundTruthAt(poses_, t, tolerance);
-    const std::string path =
-        (std::filesystem::path(pattern_.directory) / SequenceFileName(pattern_, frame)).string();
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) return std::nullopt;
-    return ReadPoseFile(path);
-  }
-
- private:
-  std::string spec_;
-  SequencePattern pattern_;
-  bool by_frame_ = false;
-  std::vector<StampedPose> poses_;
-};
 
 // Everything a replay needs, read and checked before any output is written.
 struct ReplaySetup {
