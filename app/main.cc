@@ -11,9 +11,9 @@
 #include <opencv2/core/version.hpp>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "app/ros/bag_recording.h"
 #include "app/ros/ros_commands.h"
-#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace {

@@ -138,10 +138,7 @@ CalibrationResult CalibrateDetections(const std::vector<std::string>& names,
   }
   if (found == 0) {
     result.status = CalibrationStatus::kPatternNeverFound;
-    result.message = std::string("the ") + ToString(options.pattern.kind) + " pattern (" +
-                     std::to_string(options.pattern.cols) + "x" +
-                     std::to_string(options.pattern.rows) + ") was found in none of the " +
-                     std::to_string(detections.size()) + " images";
+    result.message = PatternNeverFoundMessage(options.pattern, detections.size());
     return result;
   }
   while (true) {

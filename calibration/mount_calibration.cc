@@ -203,10 +203,7 @@ MountCalibration CalibrateMountFromDetections(const std::vector<std::string>& na
   std::vector<ViewData> data(detections.size());
   if (ClassifyViews(detections, camera, options, &data, &result) == 0) {
     result.status = MountStatus::kPatternNeverFound;
-    result.message = std::string("the ") + ToString(options.pattern.kind) + " pattern (" +
-                     std::to_string(options.pattern.cols) + "x" +
-                     std::to_string(options.pattern.rows) + ") was found in none of the " +
-                     std::to_string(detections.size()) + " images";
+    result.message = PatternNeverFoundMessage(options.pattern, detections.size());
     return result;
   }
   while (true) {

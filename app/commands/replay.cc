@@ -3,7 +3,6 @@
 // DIR/frames.csv, DIR/overlay.mp4 (or PNG frames), DIR/summary.json and, with ground truth,
 // DIR/error_plot.png. Files are written frame by frame; SIGINT/SIGTERM stop cleanly.
 #include <spdlog/spdlog.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -22,6 +21,7 @@
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "app/progress_bar.h"
 #include "app/recording.h"
 #include "app/replay_output.h"
 #include "matching/lines/line_extractor.h"
@@ -259,33 +259,6 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
   // With a calibrated mount the tilt is the head's: the camera's height and tilt follow.
   return s.head ? ReadingOnHead(*s.head, reading, reading.tilt) : reading;
 }
-
-// Prints a progress bar on stderr when it is a terminal, at most ten times a second.
-class Progress {
- public:
-  Progress(long total, bool enabled) : total_(total), enabled_(enabled && isatty(STDERR_FILENO)) {}
-  void Update(long done, int tracked, bool force = false) {
-    if (!enabled_) return;
-    const Clock::time_point now = Clock::now();
-    if (!force && now - last_ < std::chrono::milliseconds(100)) return;
-    last_ = now;
-    const double seconds = std::chrono::duration<double>(now - start_).count();
-    std::string bar;
-    if (total_ > 0) {
-      const int filled = static_cast<int>(30.0 * done / total_);
-      bar = "[" + std::string(filled, '#') + std::string(30 - filled, ' ') + "] ";
-    }
-    std::fprintf(stderr, "\r%s%ld%s frames, %.0f frames/s, %d with a pose   ", bar.c_str(), done,
-                 total_ > 0 ? ("/" + std::to_string(total_)).c_str() : "",
-                 seconds > 0 ? done / seconds : 0.0, tracked);
-    if (force) std::fprintf(stderr, "\n");
-  }
-
- private:
-  long total_;
-  bool enabled_;
-  Clock::time_point start_ = Clock::now(), last_;
-};
 
 // The localiser, tracker and model of one replay, built before any output is written.
 class ReplayTracking {
