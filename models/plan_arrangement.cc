@@ -35,11 +35,15 @@ class PointSnapper {
   }
 
  private:
-  static long long Key(long long x, long long y) { return x * 73856093LL ^ y * 19349663LL; }
+  // Spatial hash of a cell (Teschner et al. 2003); unsigned so that far cells wrap, not overflow.
+  static unsigned long long Key(long long x, long long y) {
+    return static_cast<unsigned long long>(x) * 73856093ULL ^
+           static_cast<unsigned long long>(y) * 19349663ULL;
+  }
   double radius_;
   double cell_;
   std::vector<Eigen::Vector2d>* points_;
-  std::unordered_map<long long, std::vector<int>> grid_;
+  std::unordered_map<unsigned long long, std::vector<int>> grid_;
 };
 
 int Find(std::vector<int>& parent, int x) {
