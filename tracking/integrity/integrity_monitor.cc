@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "models/geometry.h"
+#include "models/text_format.h"
 #include "tracking/integrity/consistency.h"
 
 namespace linetrack {
@@ -92,12 +93,6 @@ double LogBayesFactor(const Eigen::MatrixXd& c, const Eigen::MatrixXd& b,
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(system);
   const double log_det = ldlt.vectorD().array().log().sum();
   return -0.5 * log_det + 0.5 * (s_w.squaredNorm() - s_w.dot(ldlt.solve(s_w)));
-}
-
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
 }
 
 // Widens the levels and the covariance of `out` to bound the error of `start` rather than of the

@@ -1,4 +1,5 @@
 #include "tracking/tracker/edge_tracker.h"
+
 #include "models/silence_stdout.h"
 
 #include <visp3/core/vpEigenConversion.h>
@@ -21,6 +22,7 @@
 #include "models/cao_writer.h"
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/text_format.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -32,10 +34,6 @@ constexpr double kGoodSiteState = 0.0;
 constexpr double kNearClip = 0.05;  // metres, for the image motion of the model
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 

@@ -7,16 +7,13 @@
 
 #include "models/errors.h"
 #include "models/statistics.h"
+#include "models/text_format.h"
 
 namespace linetrack {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::optional<KnownHeightTilt> Known(const std::optional<RobotReading>& robot) {
   if (!robot) return std::nullopt;
@@ -42,12 +39,6 @@ Pose3Dof Carry(const Pose3Dof& pose, const RobotReading& then, const RobotReadin
 Eigen::Vector2d PlanarDifference(const Pose3Dof& a, const Pose3Dof& b) {
   return {std::hypot(a.x - b.x, a.y - b.y),
           std::abs(std::remainder(a.heading - b.heading, 2.0 * kPi))};
-}
-
-std::string Fixed(double value, int digits) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
 }
 
 }  // namespace
