@@ -1,5 +1,6 @@
 #include "app/ros/camera_mount_source.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "app/cli_common.h"
@@ -71,15 +72,47 @@ CameraMountSource::~CameraMountSource() = default;
 
 void CameraMountSource::OnJoints(const sensor_msgs::JointState& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // A message may carry one of the joints: the other keeps its last angle.
+  StampedHeadAngles reading =
+      joints_.empty() ? StampedHeadAngles{0.0, 0.0, options_.tilt} : joints_.back();
+  reading.t = msg.header.stamp.toSec();
+  bool named = false;
   for (size_t i = 0; i < msg.name.size() && i < msg.position.size(); ++i) {
     if (!options_.pan_joint.empty() && msg.name[i] == options_.pan_joint) {
-      pan_ = msg.position[i];
-      have_pan_ = true;
+      reading.pan = msg.position[i];
+      named = true;
     } else if (!options_.tilt_joint.empty() && msg.name[i] == options_.tilt_joint) {
-      tilt_ = msg.position[i];
-      have_tilt_ = true;
+      reading.tilt = msg.position[i];
+      named = true;
     }
   }
+  if (!named) return;
+  if (!joints_.empty() && reading.t < joints_.back().t) joints_.clear();  // time went back
+  joints_.push_back(reading);
+  while (joints_.back().t - joints_.front().t > 10.0)
+    joints_.pop_front();
+  joints_arrived_.notify_all();
+}
+
+std::optional<CameraMount> CameraMountSource::FromJoints(double t, std::string* why) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  joints_arrived_.wait_for(lock, std::chrono::duration<double>(options_.wait),
+                           [&] { return !joints_.empty() && joints_.back().t >= t; });
+  const std::optional<StampedHeadAngles> angles =
+      HeadAnglesAt({joints_.begin(), joints_.end()}, t, options_.max_gap);
+  if (!angles) {
+    *why = "no joint_states of " + options_.pan_joint + " " + options_.tilt_joint + " within " +
+           std::to_string(options_.max_gap) + " s of the image's stamp";
+    return std::nullopt;
+  }
+  CameraMount mount = Fixed();
+  mount.pan = angles->pan;
+  mount.tilt = angles->tilt;
+  if (!mount.Check(why)) {
+    *why = "joint_states of " + options_.pan_joint + " " + options_.tilt_joint + ": " + *why;
+    return std::nullopt;
+  }
+  return mount;
 }
 
 CameraMount CameraMountSource::Fixed() const {
@@ -94,10 +127,7 @@ std::optional<CameraMount> CameraMountSource::At(const std_msgs::Header& image, 
   std::optional<CameraMount> mount;
   std::string used = "fixed";
   if (source == HeadSource::kJointStates) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    mount = Fixed();
-    if (have_tilt_) mount->tilt = tilt_;
-    if (have_pan_) mount->pan = pan_;
+    mount = FromJoints(image.stamp.toSec(), why);
     used = "joint_states";
   } else if (source == HeadSource::kFixed) {
     mount = Fixed();

@@ -10,6 +10,8 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <condition_variable>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -51,11 +53,12 @@ class CameraMountSource {
   CameraMountSource(const CameraMountSourceOptions& options, const ros::NodeHandle& nh);
   ~CameraMountSource();
 
-  // joint_states: keeps the latest pan and tilt of the named joints (any thread).
+  // joint_states: keeps the last seconds of the named joints' pan and tilt (any thread).
   void OnJoints(const sensor_msgs::JointState& msg);
 
-  // The mount at the image's stamp, waiting up to `wait` for TF; nullopt with `why` when there is
-  // none (no TF at the stamp, a mount that is not a level optical frame).
+  // The mount at the image's stamp, waiting up to `wait` for the joint states or TF to reach it;
+  // nullopt with `why` when there is none (no joint state or TF near the stamp, a mount that is
+  // not a level optical frame).
   std::optional<CameraMount> At(const std_msgs::Header& image, std::string* why);
 
   // "joint_states", "tf" or "fixed": what gave the last mount.
@@ -64,14 +67,15 @@ class CameraMountSource {
  private:
   std::optional<CameraMount> FromTf(const std::string& camera_frame, const ros::Time& stamp,
                                     std::string* why);
+  std::optional<CameraMount> FromJoints(double t, std::string* why);
   CameraMount Fixed() const;
 
   CameraMountSourceOptions options_;
   std::unique_ptr<tf2_ros::Buffer> buffer_;
   std::unique_ptr<tf2_ros::TransformListener> listener_;
   mutable std::mutex mutex_;  // the joint angles and the last source
-  double pan_ = 0.0, tilt_ = 0.0;
-  bool have_pan_ = false, have_tilt_ = false;
+  std::condition_variable joints_arrived_;
+  std::deque<StampedHeadAngles> joints_;  // sorted by time
   std::string last_source_;
 };
 

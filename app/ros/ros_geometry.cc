@@ -108,6 +108,23 @@ std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& 
   return pose;
 }
 
+std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
+                                              double t, double max_gap) {
+  if (readings.empty()) return std::nullopt;
+  if (t <= readings.front().t || t >= readings.back().t) {
+    const StampedHeadAngles& end = t <= readings.front().t ? readings.front() : readings.back();
+    if (std::abs(end.t - t) > max_gap) return std::nullopt;
+    return StampedHeadAngles{t, end.pan, end.tilt};
+  }
+  const auto after = std::upper_bound(
+      readings.begin(), readings.end(), t,
+      [](double time, const StampedHeadAngles& reading) { return time < reading.t; });
+  const StampedHeadAngles& a = *(after - 1);
+  const StampedHeadAngles& b = *after;
+  const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+  return StampedHeadAngles{t, a.pan + s * (b.pan - a.pan), a.tilt + s * (b.tilt - a.tilt)};
+}
+
 SearchBounds BoundsFromCovariance(const Matrix6d& covariance, const RelocalizationOptions& limits,
                                   double sigma_scale) {
   const Eigen::Matrix2d xy = covariance.topLeftCorner<2, 2>();

@@ -80,6 +80,18 @@ struct StampedOdometry {
 std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& readings, double t,
                                             double max_gap);
 
+// A pan-tilt head's joint angles (radians) at a stamp (sensor_msgs/JointState).
+struct StampedHeadAngles {
+  double t = 0.0;  // seconds
+  double pan = 0.0, tilt = 0.0;
+};
+
+// The head's angles at time t: linear interpolation between the two readings around t; the first
+// or last reading when t is outside their range by at most max_gap seconds, else nullopt.
+// `readings` sorted by time.
+std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
+                                              double t, double max_gap);
+
 // The matcher's first bounds from an initial pose's covariance (RViz's "2D Pose Estimate": 0.25
 // m^2 in x and y, 0.0685 rad^2 in yaw): sigma_scale times the largest position and yaw
 // standard deviations, clamped to [min, max] (RelocalizationOptions); the defaults give the

@@ -130,6 +130,19 @@ TEST(RosGeometry, OdometryIsInterpolatedAtTheImageStamp) {
   EXPECT_FALSE(OdometryAt({}, 10.0, 0.1).has_value());
 }
 
+TEST(RosGeometry, HeadAnglesAreInterpolatedAtTheImageStamp) {
+  const std::vector<StampedHeadAngles> readings = {{10.0, 0.1, 0.2}, {10.2, 0.3, 0.1}};
+  const std::optional<StampedHeadAngles> mid = HeadAnglesAt(readings, 10.05, 0.1);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_NEAR(mid->pan, 0.15, kExact);
+  EXPECT_NEAR(mid->tilt, 0.175, kExact);
+  const std::optional<StampedHeadAngles> before = HeadAnglesAt(readings, 9.95, 0.1);
+  ASSERT_TRUE(before.has_value());  // within the gap: the first reading
+  EXPECT_NEAR(before->pan, 0.1, kExact);
+  EXPECT_FALSE(HeadAnglesAt(readings, 10.35, 0.1).has_value());  // beyond it
+  EXPECT_FALSE(HeadAnglesAt({}, 10.0, 0.1).has_value());
+}
+
 TEST(RosGeometry, RvizInitialPoseGivesThePapersBounds) {
   Matrix6d rviz = Matrix6d::Zero();
   rviz(0, 0) = rviz(1, 1) = 0.25;

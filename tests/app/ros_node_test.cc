@@ -11,6 +11,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/JointState.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
@@ -46,7 +47,8 @@ constexpr double kRegion999Chi2Dof3 = 16.266;
 // robot's alert limit is set above them, so that most poses are tracking.
 constexpr const char* kAlertLimit = "0.3,2";
 constexpr double kDeadlineS = 60.0;  // any one wait (sanitizer builds are slow)
-// The TF test's head: panning +-15 degrees, 0.2 m ahead of and 0.05 m right of the base's origin.
+// The TF and joint_states tests' head: panning +-15 degrees, 0.2 m ahead of and 0.05 m right of the
+// base's origin.
 constexpr double kTfPanAmplitudeDeg = 15.0;
 constexpr double kTfOffsetXM = 0.2;
 constexpr double kTfOffsetYM = -0.05;
@@ -331,6 +333,35 @@ TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
         tf2_msgs::TFMessage tf;
         tf.transforms.push_back(head_to_camera);
         node.tf_pub.publish(tf);
+      });
+  ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+  EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
+}
+
+// The head's angles from joint_states (the pan and tilt joints named on the command line), the
+// head panning +-15 degrees: each image takes the angles at its stamp.
+TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
+  NodeUnderTest node({"--odom-wait", "1", "--height", std::to_string(kHeight), "--pan-joint",
+                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints"});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ros::NodeHandle nh;
+  ros::Publisher joints_pub = nh.advertise<sensor_msgs::JointState>("/robot/joints", 100);
+  ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
+  ASSERT_TRUE(WaitFor([&] { return joints_pub.getNumSubscribers() > 0; }, kDeadlineS));
+
+  std::vector<Eigen::Isometry3d> map_from_base;
+  for (const SequenceFrame& frame : hall.frames)
+    map_from_base.push_back(PlanarIsometry(frame.base.Planar()));
+  const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
+  node.PublishInitialPose(hall.frames[0].base.Planar());
+  const std::vector<ros::Time> stamps =
+      node.Drive(hall, map_from_base, odom_from_map, [&](int i, const ros::Time& stamp) {
+        sensor_msgs::JointState joints;
+        joints.header.stamp = stamp;
+        joints.name = {"head_pan", "head_tilt"};
+        joints.position = {hall.frames[i].pan, hall.frames[i].camera.tilt};
+        joints_pub.publish(joints);
       });
   ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
