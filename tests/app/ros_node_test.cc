@@ -4,12 +4,15 @@
 // back stamped with the images' stamps, near the truth, with the integrity monitor's covariance:
 // on ~pose only tracking poses, the truth within the 99.9% region of their covariance, the
 // others on ~pose_degraded; map -> odom on /tf; the status must reach "tracking"; global
-// localisation answers with an error. Then the same with the head's angles and offset from TF
-// base_link -> camera (static and dynamic transforms) instead of --height and --tilt.
+// localisation answers with an error; overlays and diagnostics come out. Then the same with the
+// head's angles and offset from TF base -> camera (static and dynamic transforms) instead of
+// --height and --tilt, and with them from joint_states and the camera from camera_info.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/String.h>
@@ -30,6 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kCameraFile = kSource + "/tests/data/camera_wide.xml";
 
 constexpr int kFrames = 24;  // 2.4 s at 10 frames/s
 constexpr double kHeight = test::kSceneHeight;
@@ -96,12 +100,11 @@ class NodeUnderTest {
   explicit NodeUnderTest(const std::vector<std::string>& flags)
       : core_(fs::temp_directory_path() / ("linetrack_ros_" + std::to_string(getpid()))) {
     if (!core_.ready()) return;
+    // --model, and the topics the test publishes on; the rest from `flags`.
     std::vector<std::string> argv = {LINETRACK_EXE,
                                      "ros",
                                      "--model",
                                      kSource + "/models/hall.cao",
-                                     "--camera",
-                                     kSource + "/tests/data/camera_wide.xml",
                                      "--alert-limit",
                                      kAlertLimit,
                                      "image:=/camera/image_raw",
@@ -265,11 +268,40 @@ void ExpectPosesOfTheTruth(Heard& heard, const std::vector<ros::Time>& stamps,
             kOdomTolM);
 }
 
+// The overlays and the diagnostics the node publishes.
+struct HeardExtras {
+  std::mutex mutex;
+  std::vector<sensor_msgs::Image> overlays;  // headers and sizes only
+  long images_received = -1;                 // the last diagnostics' count
+  std::string hardware_id;
+};
+
 TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
   const test::RenderedDrive hall = test::RenderHallDrive(kFrames, 0.0);
-  NodeUnderTest node({"--height", std::to_string(kHeight), "--tilt", std::to_string(kTiltDeg)});
+  NodeUnderTest node({"--camera", kCameraFile, "--height", std::to_string(kHeight), "--tilt",
+                      std::to_string(kTiltDeg)});
   ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ros::NodeHandle nh;
+  HeardExtras extras;
+  ros::Subscriber overlay_sub = nh.subscribe<sensor_msgs::Image>(
+      "/linetrack/overlay", 100, [&](const sensor_msgs::ImageConstPtr& m) {
+        std::lock_guard<std::mutex> lock(extras.mutex);
+        extras.overlays.push_back(*m);
+        extras.overlays.back().data.clear();
+      });
+  ros::Subscriber diagnostics_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(extras.mutex);
+        for (const diagnostic_msgs::DiagnosticStatus& status : m->status) {
+          for (const diagnostic_msgs::KeyValue& value : status.values) {
+            if (value.key != "images received") continue;
+            extras.images_received = std::stol(value.value);
+            extras.hardware_id = status.hardware_id;
+          }
+        }
+      });
   ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
+  ASSERT_TRUE(WaitFor([&] { return overlay_sub.getNumPublishers() > 0; }, kDeadlineS));
 
   // The odometry frame is where the robot started.
   std::vector<Eigen::Isometry3d> map_from_base;
@@ -283,6 +315,30 @@ TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
   EXPECT_FALSE(ros::service::call("/linetrack/global_localization", empty))
       << "global localisation must answer with an error until it exists";
   ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+
+  // Overlays stamped with their images, up to the last, at the camera's size; diagnostics counting
+  // the images.
+  const auto overlays_done = [&] {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    return !extras.overlays.empty() && extras.overlays.back().header.stamp == stamps.back();
+  };
+  EXPECT_TRUE(WaitFor(overlays_done, kDeadlineS));
+  const auto diagnostics_done = [&] {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    return extras.images_received == kFrames;
+  };
+  EXPECT_TRUE(WaitFor(diagnostics_done, kDeadlineS)) << "no diagnostics counting the images";
+  {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    EXPECT_EQ(extras.hardware_id, "linetrack");
+    for (const sensor_msgs::Image& overlay : extras.overlays) {
+      const int i = FrameOf(stamps, overlay.header.stamp);
+      ASSERT_GE(i, 0) << "an overlay stamped " << overlay.header.stamp << ", not an image's";
+      EXPECT_EQ(overlay.encoding, "bgr8");
+      EXPECT_EQ(overlay.width, hall.images[i].getWidth());
+      EXPECT_EQ(overlay.height, hall.images[i].getHeight());
+    }
+  }
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
 }
 
@@ -295,8 +351,8 @@ TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
   // A generous wait for TF to reach each image's stamp: it comes on another connection. The
   // base's frame is a private parameter (`_name:=` sets it on the parameter server), and the
   // command line's --head wins over the parameter server's ~head.
-  NodeUnderTest node(
-      {"--odom-wait", "1", "_base_frame:=" + kTfBaseFrame, "_head:=fixed", "--head", "tf"});
+  NodeUnderTest node({"--camera", kCameraFile, "--odom-wait", "1", "_base_frame:=" + kTfBaseFrame,
+                      "_head:=fixed", "--head", "tf"});
   ASSERT_TRUE(node.started()) << "roscore or the node did not start";
   ASSERT_TRUE(node.Connected(/*tf=*/true)) << "the node did not connect";
 
@@ -338,17 +394,36 @@ TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
 }
 
+// The camera's CameraInfo (plumb_bob with k1 = ViSP's kud).
+sensor_msgs::CameraInfo CameraInfoOf(const CameraIntrinsics& camera) {
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = "camera_optical";
+  info.width = camera.width;
+  info.height = camera.height;
+  info.K = {camera.px, 0.0, camera.u0, 0.0, camera.py, camera.v0, 0.0, 0.0, 1.0};
+  info.distortion_model = "plumb_bob";
+  info.D = {camera.has_distortion ? camera.kud : 0.0, 0.0, 0.0, 0.0, 0.0};
+  return info;
+}
+
 // The head's angles from joint_states (the pan and tilt joints named on the command line), the
-// head panning +-15 degrees: each image takes the angles at its stamp.
+// head panning +-15 degrees: each image takes the angles at its stamp. The camera from
+// camera_info (no --camera).
 TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
   const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
   NodeUnderTest node({"--odom-wait", "1", "--height", std::to_string(kHeight), "--pan-joint",
-                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints"});
+                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints",
+                      "camera_info:=/camera/camera_info"});
   ASSERT_TRUE(node.started()) << "roscore or the node did not start";
   ros::NodeHandle nh;
   ros::Publisher joints_pub = nh.advertise<sensor_msgs::JointState>("/robot/joints", 100);
+  ros::Publisher info_pub =
+      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, /*latch=*/true);
+  info_pub.publish(CameraInfoOf(ReadCameraXml(kCameraFile)));
   ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
-  ASSERT_TRUE(WaitFor([&] { return joints_pub.getNumSubscribers() > 0; }, kDeadlineS));
+  ASSERT_TRUE(WaitFor(
+      [&] { return joints_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0; },
+      kDeadlineS));
 
   std::vector<Eigen::Isometry3d> map_from_base;
   for (const SequenceFrame& frame : hall.frames)
