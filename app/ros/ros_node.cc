@@ -24,6 +24,7 @@
 
 #include "app/cli_common.h"
 #include "app/replay_output.h"
+#include "app/ros/newest_only.h"
 #include "app/ros/ros_messages.h"
 #include "app/ros/ros_tracker.h"
 #include "models/errors.h"
@@ -128,7 +129,7 @@ struct RosNode::Impl {
 
   mutable std::mutex mutex;  // guards everything below
   std::condition_variable wake;
-  std::optional<PendingImage> pending;
+  NewestOnly<PendingImage> pending;
   std::optional<CameraIntrinsics> camera_from_info;
   std::optional<PendingStart> start;
   std::deque<StampedOdometry> odometry;
@@ -191,8 +192,7 @@ void RosNode::Impl::Setup() {
 void RosNode::Impl::OnImage(const sensor_msgs::ImageConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex);
   ++stats.received;
-  if (pending) ++stats.dropped;  // the waiting image is older: it goes
-  pending = PendingImage{msg, Clock::now()};
+  if (pending.Put(PendingImage{msg, Clock::now()})) ++stats.dropped;  // the older one went
   wake.notify_one();
 }
 
@@ -417,9 +417,10 @@ void RosNode::Run() {
     std::optional<Impl::PendingImage> image;
     {
       std::unique_lock<std::mutex> lock(m.mutex);
-      m.wake.wait_for(lock, std::chrono::milliseconds(100), [&] { return m.pending || m.stop; });
+      m.wake.wait_for(lock, std::chrono::milliseconds(100),
+                      [&] { return m.pending.waiting() || m.stop; });
       if (m.stop) break;
-      image.swap(m.pending);
+      image = m.pending.Take();
     }
     const Clock::time_point taken = Clock::now();
     if (image && m.EnsureTracker()) m.Process(*image, taken);

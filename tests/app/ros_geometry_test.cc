@@ -7,6 +7,7 @@
 
 #include <array>
 
+#include "app/ros/newest_only.h"
 #include "app/ros/ros_tracker.h"
 #include "models/geometry.h"
 
@@ -141,6 +142,20 @@ TEST(RosGeometry, HeadAnglesAreInterpolatedAtTheImageStamp) {
   EXPECT_NEAR(before->pan, 0.1, kExact);
   EXPECT_FALSE(HeadAnglesAt(readings, 10.35, 0.1).has_value());  // beyond it
   EXPECT_FALSE(HeadAnglesAt({}, 10.0, 0.1).has_value());
+}
+
+// Images arriving faster than they are tracked: the waiting one is replaced by the newer, each
+// replacement reported (and counted by the node), the newest taken next.
+TEST(RosNodeQueue, TheOldestWaitingImageIsDropped) {
+  NewestOnly<int> slot;
+  EXPECT_FALSE(slot.Put(1));
+  EXPECT_TRUE(slot.Put(2));
+  EXPECT_TRUE(slot.Put(3));
+  ASSERT_TRUE(slot.waiting());
+  EXPECT_EQ(slot.Take(), std::optional<int>(3));
+  EXPECT_FALSE(slot.waiting());
+  EXPECT_FALSE(slot.Take().has_value());
+  EXPECT_FALSE(slot.Put(4));  // nothing waiting: nothing dropped
 }
 
 TEST(RosGeometry, RvizInitialPoseGivesThePapersBounds) {
