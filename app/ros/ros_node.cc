@@ -310,7 +310,6 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
                        tracker_options.camera.height);
     return;
   }
-  ApplyStart();
   TrackerInput input;
   input.t = header.stamp.toSec();
   std::string why;
@@ -332,6 +331,7 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
     odom = OdometryAt(readings, input.t, options.odom_max_gap);
   }
   if (odom) input.odom_base = PlanarOf(*odom);
+  ApplyStart();  // after the odometry's wait: the initial pose is anchored to its reading
   const TrackedFrame out = tracker->Process(grey, input);
   Publish(out, header, odom);
   const double busy_ms = std::chrono::duration<double, std::milli>(Clock::now() - taken).count();
