@@ -9,8 +9,9 @@
 
 namespace linetrack::app {
 bool CameraMount::Check(std::string* why) const {
-  if (!std::isfinite(height) || !std::isfinite(pan) || !std::isfinite(tilt)) {
-    *why = "camera mount: height, pan and tilt must be finite";
+  if (!std::isfinite(height) || !std::isfinite(pan) || !std::isfinite(tilt) || !std::isfinite(x) ||
+      !std::isfinite(y) || !std::isfinite(roll)) {
+    *why = "camera mount: its position and angles must be finite";
     return false;
   }
   if (std::abs(tilt) >= DegToRad(89.0)) {
@@ -22,9 +23,25 @@ bool CameraMount::Check(std::string* why) const {
 
 Eigen::Isometry3d BaseFromCamera(const CameraMount& mount) {
   Eigen::Isometry3d base_from_cam = Eigen::Isometry3d::Identity();
-  base_from_cam.linear() = CamFromWorldRotation(mount.pan, mount.tilt).transpose();
-  base_from_cam.translation() = Eigen::Vector3d(0.0, 0.0, mount.height);
+  base_from_cam.linear() = CamFromWorldRotation(mount.pan, mount.tilt).transpose() *
+                           Eigen::AngleAxisd(mount.roll, Eigen::Vector3d::UnitZ());
+  base_from_cam.translation() = Eigen::Vector3d(mount.x, mount.y, mount.height);
   return base_from_cam;
+}
+
+CameraMount MountOfBaseFromCamera(const Eigen::Isometry3d& base_from_cam) {
+  const Eigen::Vector3d f = base_from_cam.linear().col(2);
+  const Eigen::Vector3d image_x = base_from_cam.linear().col(0);
+  CameraMount mount;
+  mount.pan = std::atan2(f.y(), f.x());
+  mount.tilt = -std::asin(std::clamp(f.z(), -1.0, 1.0));
+  // The level frame of the optical axis: rows r (image x) and d (image y) at zero roll.
+  const Eigen::Matrix3d level = CamFromWorldRotation(mount.pan, mount.tilt);
+  mount.roll = std::atan2(image_x.dot(level.row(1)), image_x.dot(level.row(0)));
+  mount.x = base_from_cam.translation().x();
+  mount.y = base_from_cam.translation().y();
+  mount.height = base_from_cam.translation().z();
+  return mount;
 }
 
 Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose) {
@@ -40,8 +57,10 @@ Pose3Dof PlanarOf(const Eigen::Isometry3d& pose) {
 }
 
 RobotPose CameraPrior(const Pose3Dof& map_base, const CameraMount& mount) {
-  // The optical centre is above the base's origin: same x, y.
-  return RobotPose{map_base.x, map_base.y, WrapAngle(map_base.heading + mount.pan), mount.height,
+  const Eigen::Vector2d centre =
+      Eigen::Vector2d(map_base.x, map_base.y) +
+      Eigen::Rotation2Dd(map_base.heading) * Eigen::Vector2d(mount.x, mount.y);
+  return RobotPose{centre.x(), centre.y(), WrapAngle(map_base.heading + mount.pan), mount.height,
                    mount.tilt};
 }
 
@@ -87,6 +106,23 @@ std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& 
   const Eigen::Quaterniond qa(a.odom_from_base.linear()), qb(b.odom_from_base.linear());
   pose.linear() = qa.slerp(s, qb).toRotationMatrix();
   return pose;
+}
+
+std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
+                                              double t, double max_gap) {
+  if (readings.empty()) return std::nullopt;
+  if (t <= readings.front().t || t >= readings.back().t) {
+    const StampedHeadAngles& end = t <= readings.front().t ? readings.front() : readings.back();
+    if (std::abs(end.t - t) > max_gap) return std::nullopt;
+    return StampedHeadAngles{t, end.pan, end.tilt};
+  }
+  const auto after = std::upper_bound(
+      readings.begin(), readings.end(), t,
+      [](double time, const StampedHeadAngles& reading) { return time < reading.t; });
+  const StampedHeadAngles& a = *(after - 1);
+  const StampedHeadAngles& b = *after;
+  const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+  return StampedHeadAngles{t, a.pan + s * (b.pan - a.pan), a.tilt + s * (b.tilt - a.tilt)};
 }
 
 SearchBounds BoundsFromCovariance(const Matrix6d& covariance, const RelocalizationOptions& limits,
