@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -242,9 +243,15 @@ void ForEach(size_t n, int threads, const StoreyOccluders& occluders, const Job&
   const size_t wanted =
       threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
   const size_t workers = std::max<size_t>(1, std::min(wanted, n / 64));
+  // A job's exception is caught in its thread and rethrown here once every thread has ended.
+  std::vector<std::exception_ptr> failures(workers);
   auto run = [&](size_t w, const StoreyOccluders& own) {
-    for (size_t i = w; i < n; i += workers)
-      job(i, own);
+    try {
+      for (size_t i = w; i < n; i += workers)
+        job(i, own);
+    } catch (...) {
+      failures[w] = std::current_exception();
+    }
   };
   std::vector<std::thread> pool;
   for (size_t w = 1; w < workers; ++w)
@@ -252,6 +259,9 @@ void ForEach(size_t n, int threads, const StoreyOccluders& occluders, const Job&
   run(0, occluders);
   for (std::thread& thread : pool)
     thread.join();
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
 }
 
 }  // namespace
