@@ -13,6 +13,7 @@ declare -A seeds=(
   [trajectory_fuzzer]="tests/data/trajectory_seeds"
   [pose_file_fuzzer]="tests/data/pose_seeds"
   [angles_fuzzer]="tests/data/angles_seeds"
+  [batch_fuzzer]="tests/data/batch_seeds"
 )
 for name in "${!seeds[@]}"; do
   fuzzer="$fuzz_dir/$name"
