@@ -62,6 +62,7 @@ struct EdgeObservation {
 // The outcome of RefineOnEdges.
 struct EdgeRefinement {
   bool applied = false;  // false: too few edge points, no improvement, or a refused correction
+  std::string refusal;   // why not applied ("too few points", "no better fit", "correction N px")
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // refined (or the start)
   int points = 0;                                                    // edge points used
   double rms_before_px = 0.0;  // point-to-line distances at the start pose

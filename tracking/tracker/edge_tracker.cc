@@ -259,6 +259,7 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
                                            {result.cam_from_world, known}, settings_.refinement);
     health.refined = refined.applied;
     health.refined_points = refined.points;
+    health.refinement_refusal = refined.refusal;
     if (refined.applied) {
       result.cam_from_world = refined.cam_from_world;
       health.refined_rms_before_px = refined.rms_before_px;
