@@ -106,6 +106,7 @@ void BoundStartPose(const Eigen::Isometry3d& start, PoseIntegrity* out) {
   const double d_rotation =
       Eigen::AngleAxisd(start.linear() * solution.linear().transpose()).angle();
   out->levels.position_m += d_centre.norm();
+  out->levels.start_offset_position_m = d_centre.norm();
   out->levels.rotation_rad += d_rotation;
   out->world_covariance.topLeftCorner<3, 3>() += d_centre * d_centre.transpose();
   out->world_covariance.bottomRightCorner<3, 3>().diagonal().array() += d_rotation * d_rotation;
@@ -123,8 +124,14 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
     return;
   }
   if (!position_ok) {
+    // What sets the level: the fault-free bound or one edge's fault, and the start pose's offset.
+    const std::string limit =
+        pl.limiting_position_edge < 0
+            ? "fault-free"
+            : "an edge fault; fault-free " + Fixed(pl.fault_free_position_m, 3) + " m";
     Append(&out->reason, "position protection " + Fixed(pl.position_m, 3) + " m > " +
-                             Fixed(options.alert_position_m, 3) + " m");
+                             Fixed(options.alert_position_m, 3) + " m (" + limit + ", start +" +
+                             Fixed(pl.start_offset_position_m, 3) + " m)");
   }
   if (!rotation_ok) {
     Append(&out->reason, "rotation protection " + Fixed(RadToDeg(pl.rotation_rad), 2) + " deg > " +

@@ -119,7 +119,8 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
   if (problem.empty() && robot && options_.robot_requires_refinement &&
       tracker_->settings().refine_subpixel && !result.health.refined) {
     problem = "the image edges do not confirm the pose (sub-pixel refinement: " +
-              std::to_string(result.health.refined_points) + " points)";
+              std::to_string(result.health.refined_points) + " points, " +
+              result.health.refinement_refusal + ")";
   }
   if (problem.empty() && robot) {
     RobotConstraint constraint = options_.robot_tolerances;
