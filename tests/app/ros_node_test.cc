@@ -399,18 +399,6 @@ TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
 }
 
-// The camera's CameraInfo (plumb_bob with k1 = ViSP's kud).
-sensor_msgs::CameraInfo CameraInfoOf(const CameraIntrinsics& camera) {
-  sensor_msgs::CameraInfo info;
-  info.header.frame_id = "camera_optical";
-  info.width = camera.width;
-  info.height = camera.height;
-  info.K = {camera.px, 0.0, camera.u0, 0.0, camera.py, camera.v0, 0.0, 0.0, 1.0};
-  info.distortion_model = "plumb_bob";
-  info.D = {camera.has_distortion ? camera.kud : 0.0, 0.0, 0.0, 0.0, 0.0};
-  return info;
-}
-
 // The head's angles from joint_states (the pan and tilt joints named on the command line), the
 // head panning +-15 degrees: each image takes the angles at its stamp. The camera from
 // camera_info (no --camera).
@@ -424,7 +412,7 @@ TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
   ros::Publisher joints_pub = nh.advertise<sensor_msgs::JointState>("/robot/joints", 100);
   ros::Publisher info_pub =
       nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, /*latch=*/true);
-  info_pub.publish(CameraInfoOf(ReadCameraXml(kCameraFile)));
+  info_pub.publish(test::CameraInfoOf(ReadCameraXml(kCameraFile)));
   ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
   ASSERT_TRUE(WaitFor(
       [&] { return joints_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0; },
