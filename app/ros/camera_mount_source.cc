@@ -1,5 +1,6 @@
 #include "app/ros/camera_mount_source.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -9,6 +10,10 @@
 #include "models/geometry.h"
 
 namespace linetrack::app {
+
+namespace {
+constexpr double kJointHistoryS = 10.0;  // seconds of joint states kept
+}  // namespace
 
 HeadSource ParseHeadSource(const std::string& name) {
   if (name == "auto") return HeadSource::kAuto;
@@ -89,8 +94,10 @@ void CameraMountSource::OnJoints(const sensor_msgs::JointState& msg) {
   if (!named) return;
   if (!joints_.empty() && reading.t < joints_.back().t) joints_.clear();  // time went back
   joints_.push_back(reading);
-  while (joints_.back().t - joints_.front().t > 10.0)
-    joints_.pop_front();
+  const double oldest = joints_.back().t - kJointHistoryS;
+  joints_.erase(joints_.begin(),
+                std::find_if(joints_.begin(), joints_.end(),
+                             [&](const StampedHeadAngles& r) { return r.t >= oldest; }));
   joints_arrived_.notify_all();
 }
 
@@ -98,8 +105,7 @@ std::optional<CameraMount> CameraMountSource::FromJoints(double t, std::string* 
   std::unique_lock<std::mutex> lock(mutex_);
   joints_arrived_.wait_for(lock, std::chrono::duration<double>(options_.wait),
                            [&] { return !joints_.empty() && joints_.back().t >= t; });
-  const std::optional<StampedHeadAngles> angles =
-      HeadAnglesAt({joints_.begin(), joints_.end()}, t, options_.max_gap);
+  const std::optional<StampedHeadAngles> angles = HeadAnglesAt(joints_, t, options_.max_gap);
   if (!angles) {
     *why = "no joint_states of " + options_.pan_joint + " " + options_.tilt_joint + " within " +
            std::to_string(options_.max_gap) + " s of the image's stamp";

@@ -11,12 +11,12 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <condition_variable>
-#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/ros/ros_geometry.h"
 
@@ -75,7 +75,7 @@ class CameraMountSource {
   std::unique_ptr<tf2_ros::TransformListener> listener_;
   mutable std::mutex mutex_;  // the joint angles and the last source
   std::condition_variable joints_arrived_;
-  std::deque<StampedHeadAngles> joints_;  // sorted by time
+  std::vector<StampedHeadAngles> joints_;  // sorted by time
   std::string last_source_;
 };
 

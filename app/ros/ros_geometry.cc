@@ -83,45 +83,58 @@ std::optional<Matrix6d> RosCovarianceOf(const PoseUncertainty& uncertainty,
   return Matrix6d(0.5 * (c + c.transpose()));
 }
 
+namespace {
+
+// The readings a <= b around time t (sorted by .t) and s = (t - a.t) / (b.t - a.t): b = a and
+// s = 0 before the first or after the last reading, when it is within max_gap of t; nullopt
+// otherwise.
+template <typename Reading>
+struct Bracket {
+  const Reading& a;
+  const Reading& b;
+  double s;
+};
+
+template <typename Reading>
+std::optional<Bracket<Reading>> BracketAt(const std::vector<Reading>& readings, double t,
+                                          double max_gap) {
+  if (readings.empty()) return std::nullopt;
+  if (t <= readings.front().t || t >= readings.back().t) {
+    const Reading& end = t <= readings.front().t ? readings.front() : readings.back();
+    if (std::abs(end.t - t) > max_gap) return std::nullopt;
+    return Bracket<Reading>{end, end, 0.0};
+  }
+  const auto after = std::upper_bound(readings.begin(), readings.end(), t,
+                                      [](double time, const Reading& r) { return time < r.t; });
+  const Reading& a = *(after - 1);
+  const Reading& b = *after;
+  return Bracket<Reading>{a, b, b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0};
+}
+
+}  // namespace
+
 std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& readings, double t,
                                             double max_gap) {
-  if (readings.empty()) return std::nullopt;
-  if (t <= readings.front().t) {
-    if (readings.front().t - t > max_gap) return std::nullopt;
-    return readings.front().odom_from_base;
-  }
-  if (t >= readings.back().t) {
-    if (t - readings.back().t > max_gap) return std::nullopt;
-    return readings.back().odom_from_base;
-  }
-  const auto after = std::upper_bound(
-      readings.begin(), readings.end(), t,
-      [](double time, const StampedOdometry& reading) { return time < reading.t; });
-  const StampedOdometry& a = *(after - 1);
-  const StampedOdometry& b = *after;
-  const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+  const auto bracket = BracketAt(readings, t, max_gap);
+  if (!bracket) return std::nullopt;
+  if (&bracket->a == &bracket->b) return bracket->a.odom_from_base;  // at an end
+  const Eigen::Isometry3d& a = bracket->a.odom_from_base;
+  const Eigen::Isometry3d& b = bracket->b.odom_from_base;
+  const double s = bracket->s;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() =
-      (1.0 - s) * a.odom_from_base.translation() + s * b.odom_from_base.translation();
-  const Eigen::Quaterniond qa(a.odom_from_base.linear()), qb(b.odom_from_base.linear());
+  pose.translation() = (1.0 - s) * a.translation() + s * b.translation();
+  const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
   pose.linear() = qa.slerp(s, qb).toRotationMatrix();
   return pose;
 }
 
 std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
                                               double t, double max_gap) {
-  if (readings.empty()) return std::nullopt;
-  if (t <= readings.front().t || t >= readings.back().t) {
-    const StampedHeadAngles& end = t <= readings.front().t ? readings.front() : readings.back();
-    if (std::abs(end.t - t) > max_gap) return std::nullopt;
-    return StampedHeadAngles{t, end.pan, end.tilt};
-  }
-  const auto after = std::upper_bound(
-      readings.begin(), readings.end(), t,
-      [](double time, const StampedHeadAngles& reading) { return time < reading.t; });
-  const StampedHeadAngles& a = *(after - 1);
-  const StampedHeadAngles& b = *after;
-  const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+  const auto bracket = BracketAt(readings, t, max_gap);
+  if (!bracket) return std::nullopt;
+  const StampedHeadAngles& a = bracket->a;
+  const StampedHeadAngles& b = bracket->b;
+  const double s = bracket->s;
   return StampedHeadAngles{t, a.pan + s * (b.pan - a.pan), a.tilt + s * (b.tilt - a.tilt)};
 }
 

@@ -270,6 +270,14 @@ void ExpectPosesOfTheTruth(Heard& heard, const std::vector<ros::Time>& stamps,
             kOdomTolM);
 }
 
+// The base's planar poses in the map, one per frame of `drive`.
+std::vector<Eigen::Isometry3d> PlanarMapFromBase(const test::RenderedDrive& drive) {
+  std::vector<Eigen::Isometry3d> map_from_base;
+  for (const SequenceFrame& frame : drive.frames)
+    map_from_base.push_back(PlanarIsometry(frame.base.Planar()));
+  return map_from_base;
+}
+
 // The overlays and the diagnostics the node publishes.
 struct HeardExtras {
   std::mutex mutex;
@@ -306,9 +314,7 @@ TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
   ASSERT_TRUE(WaitFor([&] { return overlay_sub.getNumPublishers() > 0; }, kDeadlineS));
 
   // The odometry frame is where the robot started.
-  std::vector<Eigen::Isometry3d> map_from_base;
-  for (const SequenceFrame& frame : hall.frames)
-    map_from_base.push_back(PlanarIsometry(frame.base.Planar()));
+  const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
   const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
   node.PublishInitialPose(hall.frames[0].base.Planar());
   // The odometry starts one image late (an odometry node slower to start than the camera's): the
@@ -418,9 +424,7 @@ TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
       [&] { return joints_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0; },
       kDeadlineS));
 
-  std::vector<Eigen::Isometry3d> map_from_base;
-  for (const SequenceFrame& frame : hall.frames)
-    map_from_base.push_back(PlanarIsometry(frame.base.Planar()));
+  const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
   const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
   node.PublishInitialPose(hall.frames[0].base.Planar());
   const std::vector<ros::Time> stamps =

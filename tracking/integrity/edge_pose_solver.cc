@@ -77,7 +77,7 @@ bool Linearise(const EdgeObservation& observation, const CameraIntrinsics& camer
     out->basis.row(i) << 1.0 - t, t;
   }
   out->edge_covariance = EdgeLevelCovariance(a.z(), b.z(), 0.5 * (camera.px + camera.py), noise);
-  if (!observation.casing_direction.isZero()) {
+  if (noise.casing_sigma_m > 0.0 && !observation.casing_direction.isZero()) {
     const Eigen::Vector2d k = CasingOffsets(observation, pose, camera);
     out->edge_covariance += noise.casing_sigma_m * noise.casing_sigma_m * k * k.transpose();
   }
