@@ -21,7 +21,14 @@ std::string ReadCameraText(const std::string& path) {
   if (!in || !std::filesystem::is_regular_file(path, ec)) {
     throw InputError(Located(path, 0, "cannot read the camera file"));
   }
-  return text.str();
+  // A NUL byte means a binary file; OpenCV's FileStorage parser also dereferences null on some.
+  std::string contents = text.str();
+  const size_t nul = contents.find('\0');
+  if (nul != std::string::npos) {
+    throw InputError(
+        Located(path, 0, "not a text file (a NUL byte at offset " + std::to_string(nul) + ")"));
+  }
+  return contents;
 }
 
 namespace {
