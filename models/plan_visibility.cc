@@ -40,6 +40,15 @@ void AddDirection(const Eigen::Vector2d& v, std::vector<Eigen::Vector2d>* normal
   if (norm > 1e-15) normals->push_back(v / norm);
 }
 
+// A value in (-2, 2] that increases with atan2(y, x) over (-pi, pi] (the "diamond angle"), for
+// ordering directions without a transcendental function.
+double PseudoAngle(double x, double y) {
+  const double l1 = std::abs(x) + std::abs(y);
+  if (l1 == 0.0) return 0.0;
+  const double t = 1.0 - x / l1;  // 0 along +x, 1 along +-y, 2 along -x
+  return y < 0.0 ? -t : t;
+}
+
 }  // namespace
 
 std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi) {
@@ -259,22 +268,26 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
     }
   }
   // The vectors q - p form a convex set without the origin, within pi of the centre direction;
-  // its extreme bearings are at differences of vertices.
+  // its extreme bearings are at differences of vertices. They are picked by a pseudo-angle,
+  // monotone in the angle from the centre, and only the two extremes take an atan2.
   Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
   for (const Eigen::Vector2d& f : footprint)
     f_mid += f / static_cast<double>(footprint.size());
   const Eigen::Vector2d centre = f_mid - RingCentroid(region);
   const double reference = std::atan2(centre.y(), centre.x());
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  double lo_key = std::numeric_limits<double>::infinity(), hi_key = -lo_key;
+  Eigen::Vector2d lo_v = centre, hi_v = centre;
   for (const Eigen::Vector2d& f : footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
       if (v.norm() <= kTouch) return range;
-      const double a = std::atan2(Cross2(centre, v), centre.dot(v));  // from the centre, no wrap
-      lo = std::min(lo, a);
-      hi = std::max(hi, a);
+      const double key = PseudoAngle(centre.dot(v), Cross2(centre, v));
+      if (key < lo_key) lo_key = key, lo_v = v;
+      if (key > hi_key) hi_key = key, hi_v = v;
     }
   }
+  const double lo = std::atan2(Cross2(centre, lo_v), centre.dot(lo_v));  // from the centre
+  const double hi = std::atan2(Cross2(centre, hi_v), centre.dot(hi_v));
   if (hi - lo >= kPi - 1e-9) return range;
   range.all = false;
   range.min = WrapAngle(reference + lo);
