@@ -21,5 +21,7 @@ void AddBenchTrack(CLI::App& cli, CommandAction* action);
 void AddReplay(CLI::App& cli, CommandAction* action);
 void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
+void AddHeading(CLI::App& cli, CommandAction* action);
+void AddBenchHeading(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
   app::AddReplay(cli, &action);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddHeading(cli, &action);
+  app::AddBenchHeading(cli, &action);
 
   try {
     cli.parse(argc, argv);
