@@ -156,7 +156,8 @@ RowResult RunRow(const std::vector<HeadingView>& views, const CameraIntrinsics& 
                  << RadToDeg(v.truth.tilt) << " | " << v.lines.size() << " | "
                  << v.lines_of_best_direction << " | " << kind << " | "
                  << (r.found ? std::to_string(r.hypotheses.front().support) : r.reason) << " | "
-                 << error << " |\n";
+                 << (r.found ? RadToDeg(r.hypotheses.front().heading_sigma) : 0.0) << " | " << error
+                 << " |\n";
   }
   return row;
 }
@@ -206,8 +207,8 @@ int RunBenchHeading(const BenchHeadingOptions& opt) {
         failures << "\nFailures, " << clutter << " clutter objects, tilt "
                  << (tilt_known ? "given" : "estimated") << ":\n\n"
                  << "| view | x, y, heading | tilt | lines | lines of one direction | kind | "
-                    "support or reason | error (deg) |\n| --- | --- | --- | --- | --- | --- | --- "
-                    "| --- |\n"
+                    "support or reason | sigma (deg) | error (deg) |\n| --- | --- | --- | --- | "
+                    "--- | --- | --- | --- | --- |\n"
                  << row.failures.str();
       }
     }
