@@ -23,5 +23,7 @@ void AddLive(CLI::App& cli, CommandAction* action);
 void AddBenchServo(CLI::App& cli, CommandAction* action);
 void AddHeading(CLI::App& cli, CommandAction* action);
 void AddBenchHeading(CLI::App& cli, CommandAction* action);
+void AddViews(CLI::App& cli, CommandAction* action);
+void AddBenchViews(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   app::AddBenchServo(cli, &action);
   app::AddHeading(cli, &action);
   app::AddBenchHeading(cli, &action);
+  app::AddViews(cli, &action);
+  app::AddBenchViews(cli, &action);
 
   try {
     cli.parse(argc, argv);

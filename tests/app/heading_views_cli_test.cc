@@ -1,0 +1,197 @@
+// `linetrack heading` and `linetrack views` end to end: the heading of a rendered hall view
+// (tilt given and estimated) and of exact lines, a view database built on a grid of the room
+// and read back, an image localised against it, and bad input (exit 2, one line, no output).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "models/occlusion.h"
+#include "models/robot_pose.h"
+#include "models/wireframe.h"
+#include "tests/support/cli_test.h"
+
+namespace linetrack {
+namespace {
+
+using test_support::CommandRun;
+using test_support::ReadAll;
+namespace fs = std::filesystem;
+
+const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kHall = kSource + "/models/hall.cao";
+const std::string kRoom = kSource + "/models/room.cao";
+const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
+const std::string kWideCamera = kSource + "/tests/data/camera_wide.xml";
+constexpr double kHeadingTolDeg = 1.0;  // the target for one candidate
+constexpr double kTiltTolDeg = 0.5;
+
+double NearestCandidateDeg(const nlohmann::json& headings, double truth_deg) {
+  double best = 360.0;
+  for (const auto& h : headings) {
+    best = std::min(best, std::abs(std::remainder(h.get<double>() - truth_deg, 360.0)));
+  }
+  return best;
+}
+
+class HeadingViewsCli : public test_support::CliTest {
+ protected:
+  std::string Render(const std::string& model, const std::string& camera, const std::string& pose,
+                     double tilt_deg) {
+    const std::string out = (dir_ / "view.png").string();
+    std::ostringstream args;
+    args << "render --model " << model << " --camera " << camera << " --pose " << pose
+         << " --height 1.3 --tilt " << tilt_deg << " --clutter 5 --out " << out;
+    const CommandRun run = Linetrack(args.str());
+    EXPECT_EQ(run.code, 0) << run.err;
+    return out;
+  }
+
+  // The exact visible edge pieces (at least 20 px) seen from `pose`, as a lines CSV.
+  std::string ExactLinesCsv(const std::string& model_path, const RobotPose& pose,
+                            const std::string& name) {
+    const WireframeModel model = WireframeModel::Load(model_path);
+    const OcclusionTester occlusion(model);
+    CameraIntrinsics camera = ReadCameraXml(kCamera);
+    std::ostringstream csv;
+    csv << "u1,v1,u2,v2\n" << std::setprecision(10);
+    for (const ProjectedEdge& p :
+         ProjectVisibleEdges(model, occlusion, CamFromWorld(pose), camera)) {
+      if (p.image.Length() < 20.0) continue;
+      csv << p.image.a.x() << "," << p.image.a.y() << "," << p.image.b.x() << "," << p.image.b.y()
+          << "\n";
+    }
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << csv.str();
+    return path;
+  }
+};
+
+TEST_F(HeadingViewsCli, HeadingOfARenderedViewWithTiltGivenAndEstimated) {
+  const std::string image = Render(kHall, kWideCamera, "3.0,2.0,35", 6.0);
+  const CommandRun given = Linetrack("heading " + image + " --camera " + kWideCamera + " --model " +
+                                     kHall + " --tilt 6 --json");
+  ASSERT_EQ(given.code, 0) << given.err;
+  const nlohmann::json a = nlohmann::json::parse(given.out);
+  EXPECT_TRUE(a["found"].get<bool>());
+  EXPECT_EQ(a["headings_deg"].size(), 4u);  // the hall's quarter turns
+  EXPECT_LT(NearestCandidateDeg(a["headings_deg"], 35.0), kHeadingTolDeg);
+  EXPECT_EQ(a["tilt_deg"].get<double>(), 6.0);
+  EXPECT_GT(a["vertical_lines"].get<int>(), 0);
+  ASSERT_FALSE(a["vanishing_points"].empty());
+  EXPECT_EQ(a["vanishing_points"][0]["direction"], "vertical");
+  for (const auto& vp : a["vanishing_points"])
+    EXPECT_FALSE(vp["lines"].empty());
+
+  const CommandRun estimated =
+      Linetrack("heading " + image + " --camera " + kWideCamera + " --model " + kHall + " --json");
+  ASSERT_EQ(estimated.code, 0) << estimated.err;
+  const nlohmann::json b = nlohmann::json::parse(estimated.out);
+  EXPECT_TRUE(b["tilt_estimated"].get<bool>());
+  EXPECT_NEAR(b["tilt_deg"].get<double>(), 6.0, kTiltTolDeg);
+  EXPECT_LT(NearestCandidateDeg(b["headings_deg"], 35.0), kHeadingTolDeg);
+}
+
+TEST_F(HeadingViewsCli, HeadingOfExactLinesAndTheTextForm) {
+  const std::string csv =
+      ExactLinesCsv(kHall, {3.0, 2.0, DegToRad(35.0), 1.4, DegToRad(4.0)}, "l.csv");
+  const CommandRun run = Linetrack("heading --lines " + csv + " --camera " + kCamera + " --model " +
+                                   kHall + " --tilt 4");
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("heading candidates (deg):"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("(given)"), std::string::npos);
+}
+
+TEST_F(HeadingViewsCli, HeadingBadInputExitsTwoWithOneLine) {
+  const CommandRun missing = Linetrack("heading --lines " + (dir_ / "none.csv").string() +
+                                       " --camera " + kCamera + " --model " + kHall);
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
+  const CommandRun neither = Linetrack("heading --camera " + kCamera + " --model " + kHall);
+  EXPECT_EQ(neither.code, 2);
+  EXPECT_NE(neither.err.find("IMAGE or --lines"), std::string::npos) << neither.err;
+  const std::string csv = ExactLinesCsv(kHall, {7.0, 3.0, 0.3, 1.4, 0.05}, "l.csv");
+  const CommandRun tilt = Linetrack("heading --lines " + csv + " --camera " + kCamera +
+                                    " --model " + kHall + " --tilt 95");
+  EXPECT_EQ(tilt.code, 2);
+  EXPECT_NE(tilt.err.find("--tilt"), std::string::npos) << tilt.err;
+}
+
+TEST_F(HeadingViewsCli, HeadingWithTooFewLinesExitsOne) {
+  const std::string csv = (dir_ / "one.csv").string();
+  std::ofstream(csv) << "u1,v1,u2,v2\n100,100,300,120\n";
+  const CommandRun run = Linetrack("heading --lines " + csv + " --camera " + kCamera + " --model " +
+                                   kHall + " --tilt 5 --json");
+  EXPECT_EQ(run.code, 1);
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_FALSE(j["found"].get<bool>());
+  EXPECT_FALSE(j["reason"].get<std::string>().empty());
+}
+
+TEST_F(HeadingViewsCli, ViewsBuildAndLocalizeOnTheRoom) {
+  const std::string db = (dir_ / "views").string();
+  const CommandRun build = Linetrack("views build --model " + kRoom + " --camera " + kCamera +
+                                     " --grid 1.0,45 --height 1.3 --tilt 5 --out " + db);
+  ASSERT_EQ(build.code, 0) << build.err;
+  const nlohmann::json index = nlohmann::json::parse(ReadAll(fs::path(db) / "index.json"));
+  EXPECT_EQ(index["format"], "linetrack-views");
+  const int count = index["count"].get<int>();
+  EXPECT_GT(count, 0);
+  EXPECT_EQ(count % 8, 0);  // eight headings per position
+  std::ifstream lines(fs::path(db) / "views.jsonl");
+  std::string first;
+  ASSERT_TRUE(std::getline(lines, first));
+  const nlohmann::json view = nlohmann::json::parse(first);
+  // A query from a stored view's own pose retrieves that view first.
+  const RobotPose pose{view["pose"]["x"], view["pose"]["y"],
+                       DegToRad(view["pose"]["heading_deg"].get<double>()), 1.3, DegToRad(5.0)};
+  std::string query_line;
+  RobotPose query = pose;
+  for (std::string text; std::getline(lines, text);) {
+    const nlohmann::json v = nlohmann::json::parse(text);
+    if (v["segments"].size() >= 6) {
+      query = {v["pose"]["x"], v["pose"]["y"], DegToRad(v["pose"]["heading_deg"].get<double>()),
+               1.3, DegToRad(5.0)};
+      query_line = text;
+      break;
+    }
+  }
+  ASSERT_FALSE(query_line.empty());
+  const std::string csv = ExactLinesCsv(kRoom, query, "q.csv");
+  const CommandRun run = Linetrack("views localize --lines " + csv + " --views " + db + " --json");
+  EXPECT_TRUE(run.code == 0 || run.code == 1) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  ASSERT_FALSE(j["retrieved"].empty());
+  EXPECT_EQ(j["retrieved"][0]["view"], nlohmann::json::parse(query_line)["id"]);
+  EXPECT_EQ(run.code == 0, j["valid"].get<bool>());
+}
+
+TEST_F(HeadingViewsCli, ViewsBadInputExitsTwoAndWritesNothing) {
+  const std::string db = (dir_ / "views").string();
+  const CommandRun grid = Linetrack("views build --model " + kRoom + " --camera " + kCamera +
+                                    " --grid 0,30 --out " + db);
+  EXPECT_EQ(grid.code, 2);
+  EXPECT_NE(grid.err.find("--grid"), std::string::npos) << grid.err;
+  EXPECT_FALSE(fs::exists(db));
+  const CommandRun missing =
+      Linetrack("views localize --lines x.csv --views " + (dir_ / "nothing").string());
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("index.json"), std::string::npos) << missing.err;
+  fs::create_directories(db);
+  ASSERT_EQ(Linetrack("views build --model " + kRoom + " --camera " + kCamera +
+                      " --grid 2.0,90 --out " + db)
+                .code,
+            0);
+  std::ofstream(fs::path(db) / "views.jsonl", std::ios::app) << "{\"id\": 99}\n";
+  const std::string csv = (dir_ / "one.csv").string();
+  std::ofstream(csv) << "u1,v1,u2,v2\n100,100,300,120\n";
+  const CommandRun bad = Linetrack("views localize --lines " + csv + " --views " + db);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("views.jsonl:"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace linetrack
