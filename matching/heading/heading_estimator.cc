@@ -109,6 +109,49 @@ PeakFit FitPeak(const std::vector<VoteLine>& lines, const CameraIntrinsics& came
   return peak;
 }
 
+// The segments and what they are matched against.
+struct VoteContext {
+  const std::vector<VoteLine>& lines;
+  const CameraIntrinsics& camera;
+  const ModelDirections& directions;
+  const HeadingOptions& options;
+};
+
+// The peaks of the heading vote at start.tilt, each refined, repeated ones (modulo the
+// symmetries) and those with too little support dropped; the most supported first.
+std::vector<PeakFit> FindPeaks(const VoteContext& v, RotationStart start,
+                               const std::vector<double>& symmetries) {
+  std::vector<bool> vertical;
+  VerticalScore(v.lines, v.camera, start.tilt, v.options.outlier_probability, &vertical);
+  HeadingAccumulator acc = VoteHeadings(v.lines, vertical, start.tilt, v.directions, v.options);
+  std::vector<PeakFit> peaks;
+  const double suppress = DegToRad(v.options.peak_separation_deg);
+  for (int attempt = 0; attempt < 2 * v.options.max_hypotheses && acc.Max() > 0.0 &&
+                        static_cast<int>(peaks.size()) < v.options.max_hypotheses;
+       ++attempt) {
+    start.heading = acc.Peak();
+    // Later peaks keep the first one's tilt (estimated once, on the best evidence).
+    if (!peaks.empty()) {
+      start.tilt = peaks.front().fit.tilt;
+      start.estimate_tilt = false;
+    }
+    PeakFit peak = FitPeak(v.lines, v.camera, v.directions, v.options, start);
+    for (double delta : symmetries) {
+      acc.Suppress(start.heading + delta, suppress);
+      acc.Suppress(peak.fit.heading + delta, suppress);
+    }
+    const bool repeated = std::any_of(peaks.begin(), peaks.end(), [&](const PeakFit& p) {
+      return std::any_of(symmetries.begin(), symmetries.end(), [&](double delta) {
+        return std::abs(WrapCentred(p.fit.heading + delta - peak.fit.heading, kPi)) < suppress;
+      });
+    });
+    if (peak.support >= v.options.min_support && !repeated) peaks.push_back(std::move(peak));
+  }
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const PeakFit& a, const PeakFit& b) { return a.support > b.support; });
+  return peaks;
+}
+
 HeadingHypothesis Hypothesis(const PeakFit& peak, const std::vector<double>& symmetries) {
   HeadingHypothesis h;
   h.heading = peak.fit.heading;
@@ -163,32 +206,8 @@ HeadingCandidates EstimateHeading(const std::vector<Segment2>& lines,
   start.estimate_tilt = !tilt.has_value();
   start.tilt = tilt ? *tilt : ScanTilt(vote_lines, camera, directions, options).tilt;
   const std::vector<double> symmetries = directions.Symmetries(DegToRad(options.min_gate_deg));
-  std::vector<bool> vertical;
-  VerticalScore(vote_lines, camera, start.tilt, options.outlier_probability, &vertical);
-  HeadingAccumulator acc = VoteHeadings(vote_lines, vertical, start.tilt, directions, options);
-  std::vector<PeakFit> peaks;
-  const double suppress = DegToRad(options.peak_separation_deg);
-  for (int attempt = 0; attempt < 2 * options.max_hypotheses && acc.Max() > 0.0 &&
-                        static_cast<int>(peaks.size()) < options.max_hypotheses;
-       ++attempt) {
-    start.heading = acc.Peak();
-    // Later peaks keep the first one's tilt (estimated once, on the best evidence).
-    if (!peaks.empty()) {
-      start.tilt = peaks.front().fit.tilt;
-      start.estimate_tilt = false;
-    }
-    PeakFit peak = FitPeak(vote_lines, camera, directions, options, start);
-    for (double delta : symmetries) {
-      acc.Suppress(start.heading + delta, suppress);
-      acc.Suppress(peak.fit.heading + delta, suppress);
-    }
-    const bool repeated = std::any_of(peaks.begin(), peaks.end(), [&](const PeakFit& p) {
-      return std::any_of(symmetries.begin(), symmetries.end(), [&](double delta) {
-        return std::abs(WrapCentred(p.fit.heading + delta - peak.fit.heading, kPi)) < suppress;
-      });
-    });
-    if (peak.support >= options.min_support && !repeated) peaks.push_back(std::move(peak));
-  }
+  const std::vector<PeakFit> peaks =
+      FindPeaks({vote_lines, camera, directions, options}, start, symmetries);
   if (peaks.empty()) {
     out.reason = "fewer than " + std::to_string(options.min_support) +
                  " segments share a horizontal vanishing point of the model's directions";
@@ -204,8 +223,6 @@ HeadingCandidates EstimateHeading(const std::vector<Segment2>& lines,
       return out;
     }
   }
-  std::stable_sort(peaks.begin(), peaks.end(),
-                   [](const PeakFit& a, const PeakFit& b) { return a.support > b.support; });
   for (const PeakFit& p : peaks)
     out.hypotheses.push_back(Hypothesis(p, symmetries));
   const PeakFit& best = peaks.front();

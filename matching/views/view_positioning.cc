@@ -200,6 +200,55 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> RelativePose(const RobotPose& p1, co
   return {c2.linear() * c1.linear().transpose(), c1 * p2.Centre()};
 }
 
+// The junctions the two model views share (normalised), and those of them also seen in the
+// image as triplets.
+struct SharedJunctions {
+  std::vector<Eigen::Vector2d> view1, view2;
+  Triplets triplets;
+};
+
+SharedJunctions Shared(const ViewDatabase& db, const KeyView& view1, const KeyView& view2,
+                       const std::map<int, Eigen::Vector2d>& image_points) {
+  SharedJunctions out;
+  const std::map<int, Eigen::Vector2d> pixels2 = JunctionPixels(view2);
+  for (const auto& [id, px1] : JunctionPixels(view1)) {
+    const auto px2 = pixels2.find(id);
+    if (px2 == pixels2.end()) continue;
+    out.view1.push_back(Normalised(db.camera, px1));
+    out.view2.push_back(Normalised(db.camera, px2->second));
+    const auto seen = image_points.find(id);
+    if (seen == image_points.end()) continue;
+    out.triplets.view1.push_back(out.view1.back());
+    out.triplets.view2.push_back(out.view2.back());
+    out.triplets.novel.push_back(Normalised(db.camera, seen->second));
+  }
+  return out;
+}
+
+// The world pose of the novel view (camera-from-world = U * camera1-from-world, centre = C1 +
+// R1^T c_n) and its checks.
+void SetPose(const NovelView& novel, const KeyView& view1, const ViewPositioningOptions& options,
+             ViewPositioning* out) {
+  const Eigen::Isometry3d c1 = CamFromWorld(view1.pose);
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
+  cam_from_world.linear() = novel.rotation * c1.linear();
+  const Eigen::Vector3d world_centre = c1.inverse() * novel.centre;
+  cam_from_world.translation() = -cam_from_world.linear() * world_centre;
+  out->pose = RobotPoseFromCamFromWorld(cam_from_world);
+  out->roll = RollOf(cam_from_world);
+  out->scale_a = novel.scale_a;
+  out->scale_b = novel.scale_b;
+  out->orthogonality = novel.orthogonality;
+  const double scale = 0.5 * (novel.scale_a + novel.scale_b);
+  out->weak_perspective_ok =
+      std::abs(novel.scale_a - novel.scale_b) / scale <= options.max_scale_mismatch &&
+      std::abs(novel.orthogonality) <= options.max_orthogonality;
+  out->plausible =
+      std::abs(out->roll) <= DegToRad(options.max_roll_deg) &&
+      std::abs(out->pose.tilt - view1.pose.tilt) <= DegToRad(options.max_tilt_change_deg) &&
+      std::abs(out->pose.height - view1.pose.height) <= options.max_height_change_m;
+}
+
 }  // namespace
 
 ViewPositioning LocalizeFromViews(const std::vector<Segment2>& lines, const ViewDatabase& db,
@@ -224,58 +273,25 @@ ViewPositioning LocalizeFromViews(const std::vector<Segment2>& lines, const View
   }
   const KeyView& view2 = db.views[out.view2];
   const auto [rotation, centre] = RelativePose(view1.pose, view2.pose);
+  const SharedJunctions shared = Shared(db, view1, view2, image_points);
+  out.points = static_cast<int>(shared.triplets.novel.size());
   // Z0: the mean depth of every junction the two model views share.
-  const std::map<int, Eigen::Vector2d> pixels1 = JunctionPixels(view1),
-                                       pixels2 = JunctionPixels(view2);
-  std::vector<Eigen::Vector2d> shared1, shared2;
-  Triplets triplets;
-  for (const auto& [id, px1] : pixels1) {
-    const auto px2 = pixels2.find(id);
-    if (px2 == pixels2.end()) continue;
-    shared1.push_back(Normalised(db.camera, px1));
-    shared2.push_back(Normalised(db.camera, px2->second));
-    const auto seen = image_points.find(id);
-    if (seen == image_points.end()) continue;
-    triplets.view1.push_back(shared1.back());
-    triplets.view2.push_back(shared2.back());
-    triplets.novel.push_back(Normalised(db.camera, seen->second));
-  }
-  out.points = static_cast<int>(triplets.novel.size());
-  const auto z0 = MeanTriangulatedDepth(shared1, shared2, rotation, centre);
+  const auto z0 = MeanTriangulatedDepth(shared.view1, shared.view2, rotation, centre);
   const auto w2 = z0 ? WeakPerspectiveOf(rotation, centre, *z0) : std::nullopt;
   if (!w2) {
     out.reason = "the two stored views give no reference depth";
     return out;
   }
   out.reference_depth = *z0;
-  const auto fit = RobustCombination(triplets, options.inlier_px / db.camera.px, options);
+  const auto fit = RobustCombination(shared.triplets, options.inlier_px / db.camera.px, options);
   if (!fit) {
     out.reason = "fewer than " + std::to_string(options.min_points) +
                  " junctions agree on a combination of the two views";
     return out;
   }
   out.inliers = static_cast<int>(fit->inliers.size());
-  const NovelView novel = RecoverNovelView(fit->combination, *w2, *z0);
-  // World pose: camera-from-world = U * camera1-from-world, centre = C1 + R1^T c_n.
-  const Eigen::Isometry3d c1 = CamFromWorld(view1.pose);
-  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
-  cam_from_world.linear() = novel.rotation * c1.linear();
-  const Eigen::Vector3d world_centre = c1.inverse() * novel.centre;
-  cam_from_world.translation() = -cam_from_world.linear() * world_centre;
-  out.pose = RobotPoseFromCamFromWorld(cam_from_world);
-  out.roll = RollOf(cam_from_world);
-  out.scale_a = novel.scale_a;
-  out.scale_b = novel.scale_b;
-  out.orthogonality = novel.orthogonality;
   out.rms_px = fit->combination.rms * db.camera.px;
-  const double scale = 0.5 * (novel.scale_a + novel.scale_b);
-  out.weak_perspective_ok =
-      std::abs(novel.scale_a - novel.scale_b) / scale <= options.max_scale_mismatch &&
-      std::abs(novel.orthogonality) <= options.max_orthogonality;
-  out.plausible =
-      std::abs(out.roll) <= DegToRad(options.max_roll_deg) &&
-      std::abs(out.pose.tilt - view1.pose.tilt) <= DegToRad(options.max_tilt_change_deg) &&
-      std::abs(out.pose.height - view1.pose.height) <= options.max_height_change_m;
+  SetPose(RecoverNovelView(fit->combination, *w2, *z0), view1, options, &out);
   out.found = true;
   return out;
 }

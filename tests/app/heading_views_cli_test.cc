@@ -169,6 +169,25 @@ TEST_F(HeadingViewsCli, ViewsBuildAndLocalizeOnTheRoom) {
   EXPECT_EQ(run.code == 0, j["valid"].get<bool>());
 }
 
+TEST_F(HeadingViewsCli, ViewsBuildFromRenderedImages) {
+  const std::string db = (dir_ / "rendered").string();
+  const CommandRun build = Linetrack("views build --model " + kRoom + " --camera " + kWideCamera +
+                                     " --grid 2.0,90 --render --clutter 2 --out " + db);
+  ASSERT_EQ(build.code, 0) << build.err;
+  EXPECT_NE(build.out.find("rendered"), std::string::npos) << build.out;
+  std::ifstream lines(fs::path(db) / "views.jsonl");
+  int views = 0, with_ids = 0, unknown = 0;
+  for (std::string text; std::getline(lines, text); ++views) {
+    const nlohmann::json view = nlohmann::json::parse(text);
+    for (const auto& s : view["segments"])
+      (s[4].get<int>() >= 0 ? with_ids : unknown) += 1;
+  }
+  EXPECT_GT(views, 0);
+  // Detected lines along model edges carry the edge's id; the clutter's and the texture's none.
+  EXPECT_GT(with_ids, views);
+  EXPECT_GT(unknown, 0);
+}
+
 TEST_F(HeadingViewsCli, ViewsBadInputExitsTwoAndWritesNothing) {
   const std::string db = (dir_ / "views").string();
   const CommandRun grid = Linetrack("views build --model " + kRoom + " --camera " + kCamera +
