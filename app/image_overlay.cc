@@ -13,7 +13,7 @@
 
 #include "matching/lines/undistortion.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/geometry.h"
 
 namespace linetrack::app {
 

@@ -16,8 +16,8 @@
 #include "tracking/capture/frame_source.h"
 #include "tracking/head/pan_tilt_head.h"
 #include "tracking/live/live_loop.h"
-#include "tracking/live/sim_rig.h"
 #include "tracking/live/tracker_estimator.h"
+#include "tracking/sim/sim_rig.h"
 
 namespace linetrack::app {
 

@@ -5,7 +5,7 @@
 #include <map>
 #include <memory>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "models/robot_pose.h"
 
 namespace linetrack::app {

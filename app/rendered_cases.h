@@ -1,5 +1,5 @@
 // Rendered localisation cases for the image benchmarks: poses and priors drawn as `linetrack
-// synth` draws them (models/synthetic_scenes.h), each view rendered (models/render/) with its
+// synth` draws them (models/synth/synthetic_scenes.h), each view rendered (models/render/) with its
 // ground truth: the visible model edges projected with the true pose, and the parts of them an
 // image can show (not hidden by unmodelled clutter, with an intensity step).
 #pragma once
@@ -9,12 +9,12 @@
 #include <cstdint>
 #include <vector>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/occlusion.h"
 #include "models/render/scene_renderer.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 #include "models/wireframe.h"
 
 namespace linetrack::app {

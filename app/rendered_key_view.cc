@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <set>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 
 namespace linetrack::app {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/statistics.h"
 #include "models/trajectory_io.h"
-#include "tracking/tracker/track_bench.h"
 
 namespace linetrack::app {
 
@@ -23,9 +23,9 @@ std::string Fixed(double value, int decimals) {
 }
 
 nlohmann::ordered_json Percentiles(const std::vector<double>& values) {
-  return {{"p50", Quantile(values, 0.5)},
-          {"p90", Quantile(values, 0.9)},
-          {"p99", Quantile(values, 0.99)},
+  return {{"p50", QuantileNearestRank(values, 0.5)},
+          {"p90", QuantileNearestRank(values, 0.9)},
+          {"p99", QuantileNearestRank(values, 0.99)},
           {"max", values.empty() ? 0.0 : *std::max_element(values.begin(), values.end())}};
 }
 
@@ -34,7 +34,7 @@ nlohmann::ordered_json Statistics(const std::vector<double>& values) {
   for (double v : values)
     sum += v;
   return {{"mean", values.empty() ? 0.0 : sum / values.size()},
-          {"median", Quantile(values, 0.5)},
+          {"median", QuantileNearestRank(values, 0.5)},
           {"max", values.empty() ? 0.0 : *std::max_element(values.begin(), values.end())}};
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "models/errors.h"
+#include "models/statistics.h"
 
 namespace linetrack {
 namespace {
@@ -26,12 +27,6 @@ BoardView MakeView(const std::string& name, const PatternDetection& d,
   for (int id : d.point_ids)
     view.board_points.push_back(board[static_cast<size_t>(id)]);
   return view;
-}
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <limits>
 #include <set>
 
+#include "models/statistics.h"
+
 namespace linetrack {
 namespace {
 
@@ -27,13 +29,6 @@ std::vector<int> AllIds(int count) {
   for (int i = 0; i < count; ++i)
     ids[static_cast<size_t>(i)] = i;
   return ids;
-}
-
-// Value below which `fraction` of the (unsorted) values lie.
-double Percentile(std::vector<float> values, double fraction) {
-  const size_t k = static_cast<size_t>(fraction * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
 }
 
 // Smallest distance between grid neighbours (pixels) of corners ordered row by row.
@@ -176,8 +171,8 @@ double EstimateEdgeBlur(const cv::Mat& gray, const std::vector<Eigen::Vector2d>&
     }
   }
   if (static_cast<int>(intensity.size()) < kMinBlurPixels) return 0.0;
-  const double height = Percentile(intensity, 0.95) - Percentile(intensity, 0.05);
-  const double peak = Percentile(slope, 0.99);
+  const double height = QuantileLowerRank(intensity, 0.95) - QuantileLowerRank(intensity, 0.05);
+  const double peak = QuantileLowerRank(slope, 0.99);
   if (!(peak > 0.0)) return 0.0;
   const double raw = height / (std::sqrt(2.0 * M_PI) * peak);
   // A central difference averages the slope over two pixels (a box of variance 1/3).

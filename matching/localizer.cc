@@ -21,7 +21,11 @@ bool LocalizerOptions::Check(std::string* why) const {
     *why = "unsearched_branches_share: must be in [0, 1]";
     return false;
   }
-  return noise.Check(why) && tree.Check(why) && baseline.Check(why) && verification.Check(why);
+  if (method == MatchMethod::kHypothesizeAndTest && !sampler) {
+    *why = "method: hypothesise-and-test needs a sampler";
+    return false;
+  }
+  return noise.Check(why) && tree.Check(why) && verification.Check(why);
 }
 
 void CheckProblem(const LocalizationProblem& p) {
@@ -239,9 +243,7 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     context.pair_tests = nullptr;
     context.consensus_memo = nullptr;
   } else {
-    BaselineStats stats;
-    verified = SampleAndVerify(context, prior, options_.baseline, options_.verification, &stats);
-    result.samples = stats.samples;
+    verified = options_.sampler(context, prior, options_.verification, &result.samples);
   }
   if (options_.method != MatchMethod::kInterpretationTree) {
     result.hypotheses = static_cast<int>(verified.size());

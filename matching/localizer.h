@@ -4,13 +4,13 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "matching/baseline_sampler.h"
 #include "matching/interpretation_tree.h"
 #include "matching/observed_line.h"
 #include "matching/verification.h"
@@ -22,15 +22,23 @@
 
 namespace linetrack {
 
-// How hypotheses are generated: the paper's interpretation tree, or the benchmark's baseline
-// (random pairs of correspondences, no tree).
+// How hypotheses are generated: the paper's interpretation tree, or hypothesise-and-test by the
+// options' sampler (the benchmark's baseline: random pairs of correspondences, no tree;
+// matching/evaluation/baseline_sampler.h).
 enum class MatchMethod { kInterpretationTree, kHypothesizeAndTest };
+
+// Hypothesise-and-test without the tree: draws hypotheses inside the prior region, verifies each
+// against the context's lines with `verification`, and returns every verified pose; *samples
+// counts its draws.
+using HypothesisSampler = std::function<std::vector<VerifiedPose>(
+    const VerificationContext& context, const PriorRegion& prior,
+    const VerificationOptions& verification, int* samples)>;
 
 struct LocalizerOptions {
   MatchMethod method = MatchMethod::kInterpretationTree;
   LineNoise noise;  // measurement noise the margins come from
   InterpretationTreeOptions tree;
-  BaselineOptions baseline;
+  HypothesisSampler sampler;  // required by kHypothesizeAndTest
   VerificationOptions verification;
   // Budgets (nodes, checks, leaves, guided-matching pair tests) of each search over the lines an
   // exhausted search's best pose leaves unexplained, as a share of the main search's (two such

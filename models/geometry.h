@@ -44,4 +44,8 @@ inline double Cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
 }
 
+// Clips the image segment `s` (pixels) to the rectangle [0, width - 1] x [0, height - 1] (the
+// image as ClipToFrustum sees it; Liang-Barsky); false when nothing is left.
+bool ClipSegmentToImage(double width, double height, Segment2* s);
+
 }  // namespace linetrack

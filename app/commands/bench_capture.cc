@@ -8,11 +8,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/bench/capture_bench.h"
 #include "app/commands.h"
 #include "models/errors.h"
-#include "tracking/capture/capture_bench.h"
-#include "tracking/capture/fake_gige_camera.h"
 #include "tracking/capture/source_factory.h"
+#include "tracking/fake_gige/fake_gige_camera.h"
 
 namespace linetrack::app {
 namespace {

@@ -19,9 +19,10 @@
 #include "app/commands.h"
 #include "app/image_overlay.h"
 #include "app/rendered_cases.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
+#include "models/statistics.h"
 
 namespace linetrack::app {
 namespace {
@@ -64,12 +65,6 @@ double Rms(const std::vector<double>& v) {
   for (double x : v)
     sum += x * x;
   return v.empty() ? 0.0 : std::sqrt(sum / v.size());
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
 CameraIntrinsics WideCamera() {
@@ -189,14 +184,15 @@ std::string Row(const std::string& set, const std::string& detector, const Figur
                 bool has_truth) {
   std::ostringstream row;
   row << std::fixed << std::setprecision(2) << "| " << set << " | " << detector << " | "
-      << Quantile(f.best_ms, 0.5) << " | " << Quantile(f.ms, 0.5) << " | " << Quantile(f.ms, 0.9)
-      << " | " << std::setprecision(0) << Quantile(f.segments, 0.5) << " | ";
+      << QuantileNearestRank(f.best_ms, 0.5) << " | " << QuantileNearestRank(f.ms, 0.5) << " | "
+      << QuantileNearestRank(f.ms, 0.9) << " | " << std::setprecision(0)
+      << QuantileNearestRank(f.segments, 0.5) << " | ";
   if (has_truth) {
     row << f.found << " / " << f.edges << " (" << std::setprecision(1)
         << 100.0 * f.found / std::max(1, f.edges) << " %) | " << f.all_found << " / " << f.all_edges
         << " (" << 100.0 * f.all_found / std::max(1, f.all_edges) << " %) | "
-        << std::setprecision(2) << Quantile(f.endpoint_errors, 0.5) << " / "
-        << Quantile(f.endpoint_errors, 0.9) << " | " << Rms(f.offsets_px) << " / "
+        << std::setprecision(2) << QuantileNearestRank(f.endpoint_errors, 0.5) << " / "
+        << QuantileNearestRank(f.endpoint_errors, 0.9) << " | " << Rms(f.offsets_px) << " / "
         << Rms(f.angle_errors_deg) << " |";
   } else {
     row << "- | - | - | - |";

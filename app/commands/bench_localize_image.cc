@@ -16,10 +16,11 @@
 #include "app/localize_image.h"
 #include "app/match_outcome.h"
 #include "app/rendered_cases.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
+#include "models/statistics.h"
 #include "models/view_invariant_regions.h"
 
 namespace linetrack::app {
@@ -74,12 +75,6 @@ Outcome Judge(const RenderedCase& c, const LocalizationResult& result,
       });
   return JudgeMatch(result.found, all_true,
                     ErrorsOf(result.pose.Planar(), result.covariance, c.scene.truth.Planar()));
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
 LocalizationProblem Problem(const RenderedCase& c, std::vector<Segment2> lines) {
@@ -214,12 +209,14 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
         << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
         << "| " << counts[0] << " (" << std::setprecision(1) << 100.0 * counts[0] / n << " %) | "
         << counts[1] << " | " << counts[2] << " | " << counts[3] << " | " << accurate << " ("
-        << 100.0 * accurate / n << " %) | " << std::setprecision(2) << Quantile(lines_ms, 0.5)
-        << " / " << Quantile(lines_ms, 0.9) << " | " << Quantile(matcher_ms, 0.5) << " / "
-        << Quantile(matcher_ms, 0.9) << " | " << Quantile(total_ms, 0.5) << " / "
-        << Quantile(total_ms, 0.9) << " | " << std::setprecision(0) << Quantile(segments, 0.5)
-        << " | " << std::setprecision(3) << Quantile(position_error, 0.5) << " m, "
-        << std::setprecision(2) << Quantile(heading_error, 0.5) << " deg |\n\n"
+        << 100.0 * accurate / n << " %) | " << std::setprecision(2)
+        << QuantileNearestRank(lines_ms, 0.5) << " / " << QuantileNearestRank(lines_ms, 0.9)
+        << " | " << QuantileNearestRank(matcher_ms, 0.5) << " / "
+        << QuantileNearestRank(matcher_ms, 0.9) << " | " << QuantileNearestRank(total_ms, 0.5)
+        << " / " << QuantileNearestRank(total_ms, 0.9) << " | " << std::setprecision(0)
+        << QuantileNearestRank(segments, 0.5) << " | " << std::setprecision(3)
+        << QuantileNearestRank(position_error, 0.5) << " m, " << std::setprecision(2)
+        << QuantileNearestRank(heading_error, 0.5) << " deg |\n\n"
         << "Not correct: " << causes[0] + causes[1] + causes[2] << "; by cause: " << causes[0]
         << " " << kCauseNames[0] << ", " << causes[1] << " " << kCauseNames[1] << ", " << causes[2]
         << " " << kCauseNames[2] << ".\n";

@@ -15,10 +15,12 @@
 
 #include "app/commands.h"
 #include "app/match_outcome.h"
-#include "matching/diagnosis.h"
+#include "matching/evaluation/baseline_sampler.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/statistics.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 namespace {
@@ -63,13 +65,6 @@ struct Tally {
   int Total() const { return correct + none + wrong_accurate + wrong; }
 };
 
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  return v[i];
-}
-
 using Outcome = MatchOutcome;
 
 // How far the answer is from the truth (app/match_outcome.h).
@@ -112,7 +107,7 @@ Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, dou
   return outcome;
 }
 
-// The first stage at which the truth is lost (see matching/diagnosis.h).
+// The first stage at which the truth is lost (see matching/evaluation/diagnosis.h).
 std::string Classify(const TruthDiagnosis& d, const LocalizationResult& result) {
   if (!d.plausible && d.implausible_because == "unobservable") return "uninformative truth";
   if (d.candidate_edges < d.true_edges) return "true edge not a candidate";
@@ -266,11 +261,11 @@ std::string Row(const std::string& matcher, const Tally& t) {
   const double n = std::max(1, t.Total());
   row << std::fixed << "| " << matcher << " | " << t.correct << " (" << std::setprecision(1)
       << 100.0 * t.correct / n << " %) | " << t.none << " | " << t.wrong_accurate << " | "
-      << t.wrong << " | " << std::setprecision(0) << Percentile(t.hypotheses, 0.5) << " / "
-      << Percentile(t.hypotheses, 1.0) << " | " << std::setprecision(2)
-      << Percentile(t.times_ms, 0.5) << " / " << Percentile(t.times_ms, 0.99) << " | "
-      << std::setprecision(3) << Percentile(t.position_error_m, 0.5) << " m, "
-      << std::setprecision(2) << Percentile(t.heading_error_deg, 0.5) << " deg |";
+      << t.wrong << " | " << std::setprecision(0) << QuantileNearestRank(t.hypotheses, 0.5) << " / "
+      << QuantileNearestRank(t.hypotheses, 1.0) << " | " << std::setprecision(2)
+      << QuantileNearestRank(t.times_ms, 0.5) << " / " << QuantileNearestRank(t.times_ms, 0.99)
+      << " | " << std::setprecision(3) << QuantileNearestRank(t.position_error_m, 0.5) << " m, "
+      << std::setprecision(2) << QuantileNearestRank(t.heading_error_deg, 0.5) << " deg |";
   return row.str();
 }
 
@@ -312,7 +307,9 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     LocalizerOptions tree_options;
     LocalizerOptions baseline_options;
     baseline_options.method = MatchMethod::kHypothesizeAndTest;
-    baseline_options.baseline.max_samples = opt.baseline_samples;
+    BaselineOptions baseline_sampling;
+    baseline_sampling.max_samples = opt.baseline_samples;
+    baseline_options.sampler = BaselineSampler(baseline_sampling);
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);
     Tally tree_tally, baseline_tally;
@@ -398,8 +395,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->add_option("--diagnose", opt->diagnose_path,
                   "Write a JSON line per scene the tree does not answer correctly: where the "
-                  "true correspondences are lost (matching/diagnosis.h); and a short one per "
-                  "correct answer whose search budget ran out");
+                  "true correspondences are lost (matching/evaluation/diagnosis.h); and a short "
+                  "one per correct answer whose search budget ran out");
   cmd->add_option("--only", opt->only,
                   "Run only these scene indices (0-based, of the --count generated; debugging)")
       ->delimiter(',');

@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "app/bench/servo_bench.h"
 #include "app/commands.h"
 #include "app/localize_image.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
-#include "tracking/live/servo_bench.h"
-#include "tracking/tracker/track_bench.h"
+#include "models/statistics.h"
 
 namespace linetrack::app {
 namespace {
@@ -45,17 +45,17 @@ nlohmann::ordered_json ToJson(const ServoBenchRun& r) {
           {"mean_error_px", r.mean_error_px},
           {"p95_error_px", r.p95_error_px},
           {"max_error_px", r.max_error_px},
-          {"loop_ms_median", Quantile(r.loop_ms, 0.5)},
-          {"loop_ms_p95", Quantile(r.loop_ms, 0.95)},
-          {"loop_ms_max", Quantile(r.loop_ms, 1.0)},
-          {"estimate_ms_median", Quantile(r.estimate_ms, 0.5)},
-          {"capture_ms_median", Quantile(r.grab_ms, 0.5)},
+          {"loop_ms_median", QuantileNearestRank(r.loop_ms, 0.5)},
+          {"loop_ms_p95", QuantileNearestRank(r.loop_ms, 0.95)},
+          {"loop_ms_max", QuantileNearestRank(r.loop_ms, 1.0)},
+          {"estimate_ms_median", QuantileNearestRank(r.estimate_ms, 0.5)},
+          {"capture_ms_median", QuantileNearestRank(r.grab_ms, 0.5)},
           {"tracker_stages_ms_median",
-           {{"undistort", Quantile(r.undistort_ms, 0.5)},
-            {"predict", Quantile(r.predict_ms, 0.5)},
-            {"passes", Quantile(r.passes_ms, 0.5)},
-            {"measure", Quantile(r.measure_ms, 0.5)},
-            {"relocalize", Quantile(r.relocalize_ms, 0.5)}}},
+           {{"undistort", QuantileNearestRank(r.undistort_ms, 0.5)},
+            {"predict", QuantileNearestRank(r.predict_ms, 0.5)},
+            {"passes", QuantileNearestRank(r.passes_ms, 0.5)},
+            {"measure", QuantileNearestRank(r.measure_ms, 0.5)},
+            {"relocalize", QuantileNearestRank(r.relocalize_ms, 0.5)}}},
           {"tracking_passes_per_frame", PassesPerFrame(r)}};
 }
 
@@ -99,15 +99,18 @@ int RunBenchServo(BenchServoCommandOptions opt) {
        << ", feed-forward " << (opt.no_feed_forward ? "off" : "on") << "\n";
   for (const ServoBenchRun& r : runs) {
     text << r.name << ": " << r.frames << " frames; loop (capture excluded) median "
-         << Quantile(r.loop_ms, 0.5) << " ms, 95% " << Quantile(r.loop_ms, 0.95) << " ms, max "
-         << Quantile(r.loop_ms, 1.0) << " ms; estimate median " << Quantile(r.estimate_ms, 0.5)
-         << " ms; capture (render) median " << Quantile(r.grab_ms, 0.5) << " ms\n";
+         << QuantileNearestRank(r.loop_ms, 0.5) << " ms, 95% "
+         << QuantileNearestRank(r.loop_ms, 0.95) << " ms, max "
+         << QuantileNearestRank(r.loop_ms, 1.0) << " ms; estimate median "
+         << QuantileNearestRank(r.estimate_ms, 0.5) << " ms; capture (render) median "
+         << QuantileNearestRank(r.grab_ms, 0.5) << " ms\n";
     if (!r.passes_ms.empty()) {
-      text << "  tracker stages, medians: undistortion " << Quantile(r.undistort_ms, 0.5)
-           << " ms, odometry prediction " << Quantile(r.predict_ms, 0.5) << " ms, ViSP passes "
-           << Quantile(r.passes_ms, 0.5) << " ms (" << PassesPerFrame(r)
-           << " per frame), measure and refinement " << Quantile(r.measure_ms, 0.5)
-           << " ms; re-localisation 95% " << Quantile(r.relocalize_ms, 0.95) << " ms\n";
+      text << "  tracker stages, medians: undistortion " << QuantileNearestRank(r.undistort_ms, 0.5)
+           << " ms, odometry prediction " << QuantileNearestRank(r.predict_ms, 0.5)
+           << " ms, ViSP passes " << QuantileNearestRank(r.passes_ms, 0.5) << " ms ("
+           << PassesPerFrame(r) << " per frame), measure and refinement "
+           << QuantileNearestRank(r.measure_ms, 0.5) << " ms; re-localisation 95% "
+           << QuantileNearestRank(r.relocalize_ms, 0.95) << " ms\n";
     }
     text << "  true target error: start " << r.start_error_px << " px, below 2 px at "
          << r.convergence_s << " s, final " << r.final_error_px << " px; after " << r.settle_s

@@ -10,9 +10,10 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "app/bench/track_bench.h"
 #include "app/commands.h"
 #include "models/errors.h"
-#include "tracking/tracker/track_bench.h"
+#include "models/statistics.h"
 
 namespace linetrack::app {
 namespace {
@@ -58,37 +59,38 @@ int RunBenchTrack(const BenchTrackOptions& opt) {
       s.settings.first_passes_max_iterations = opt.first_passes_iterations;
     }
     const TrackBenchResult r = RunTrackBench(s, opt.repeats);
-    const double visp_median = Quantile(r.visp_ms, 0.5);
-    const double ours_median = Quantile(r.linetrack_ms, 0.5);
-    const double visp_cpu = Quantile(r.visp_cpu_ms, 0.5);
-    const double ours_cpu = Quantile(r.linetrack_cpu_ms, 0.5);
+    const double visp_median = QuantileNearestRank(r.visp_ms, 0.5);
+    const double ours_median = QuantileNearestRank(r.linetrack_ms, 0.5);
+    const double visp_cpu = QuantileNearestRank(r.visp_cpu_ms, 0.5);
+    const double ours_cpu = QuantileNearestRank(r.linetrack_cpu_ms, 0.5);
     const double ratio = visp_cpu > 0.0 ? ours_cpu / visp_cpu : 0.0;
     rows.push_back({{"sequence", r.name},
                     {"frames", r.frames},
                     {"visp_ms_median", visp_median},
-                    {"visp_ms_p90", Quantile(r.visp_ms, 0.9)},
+                    {"visp_ms_p90", QuantileNearestRank(r.visp_ms, 0.9)},
                     {"visp_cpu_ms_median", visp_cpu},
                     {"linetrack_ms_median", ours_median},
-                    {"linetrack_ms_p90", Quantile(r.linetrack_ms, 0.9)},
+                    {"linetrack_ms_p90", QuantileNearestRank(r.linetrack_ms, 0.9)},
                     {"linetrack_cpu_ms_median", ours_cpu},
                     {"cpu_ratio_of_medians", ratio},
                     {"replay_fps", r.replay_fps},
                     {"passes_per_frame", r.replay_passes},
                     {"visp_tracked", r.visp_tracked},
                     {"linetrack_tracked", r.linetrack_tracked},
-                    {"passes_ms_median", Quantile(r.passes_ms, 0.5)},
-                    {"measure_ms_median", Quantile(r.measure_ms, 0.5)}});
+                    {"passes_ms_median", QuantileNearestRank(r.passes_ms, 0.5)},
+                    {"measure_ms_median", QuantileNearestRank(r.measure_ms, 0.5)}});
     if (!opt.json) {
       std::cout << std::left << std::setw(23) << r.name << std::right << std::setw(6) << r.frames
-                << std::setw(8) << visp_median << std::setw(7) << Quantile(r.visp_ms, 0.9)
-                << std::setw(7) << visp_cpu << std::setw(9) << ours_median << std::setw(7)
-                << Quantile(r.linetrack_ms, 0.9) << std::setw(7) << ours_cpu << std::setw(8)
-                << ratio << std::setw(8) << std::setprecision(0) << r.replay_fps
-                << std::setprecision(2) << std::setw(8) << r.replay_passes << "  " << r.visp_tracked
-                << "/" << r.linetrack_tracked << "\n"
-                << "    linetrack stages, wall medians: ViSP passes " << Quantile(r.passes_ms, 0.5)
-                << " ms, moving-edge states and refinement " << Quantile(r.measure_ms, 0.5)
-                << " ms\n";
+                << std::setw(8) << visp_median << std::setw(7)
+                << QuantileNearestRank(r.visp_ms, 0.9) << std::setw(7) << visp_cpu << std::setw(9)
+                << ours_median << std::setw(7) << QuantileNearestRank(r.linetrack_ms, 0.9)
+                << std::setw(7) << ours_cpu << std::setw(8) << ratio << std::setw(8)
+                << std::setprecision(0) << r.replay_fps << std::setprecision(2) << std::setw(8)
+                << r.replay_passes << "  " << r.visp_tracked << "/" << r.linetrack_tracked << "\n"
+                << "    linetrack stages, wall medians: ViSP passes "
+                << QuantileNearestRank(r.passes_ms, 0.5)
+                << " ms, moving-edge states and refinement "
+                << QuantileNearestRank(r.measure_ms, 0.5) << " ms\n";
     }
   }
   std::error_code ec;

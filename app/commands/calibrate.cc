@@ -17,6 +17,7 @@
 #include "app/commands.h"
 #include "calibration/output_files.h"
 #include "models/errors.h"
+#include "models/statistics.h"
 #include "tracking/capture/source_factory.h"
 
 namespace linetrack::app {
@@ -206,14 +207,11 @@ int RunBenchCalibrate(CalibrateCommandOptions opt) {
       return kExitJobFailed;
     }
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   std::cout << std::fixed << std::setprecision(3) << "calibration of " << images.size()
             << " images (" << result.UsedViews() << " views used, " << opt.repeat
-            << " runs, median): detection " << median(detect) << " s, estimation "
-            << median(estimate) << " s, total " << median(total) << " s\n";
+            << " runs, median): detection " << QuantileNearestRank(detect, 0.5) << " s, estimation "
+            << QuantileNearestRank(estimate, 0.5) << " s, total " << QuantileNearestRank(total, 0.5)
+            << " s\n";
   return kExitOk;
 }
 

@@ -25,12 +25,12 @@
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/statistics.h"
 #include "models/trajectory_io.h"
 #include "tracking/capture/source_factory.h"
 #include "tracking/head/head_factory.h"
 #include "tracking/live/live_overlay.h"
-#include "tracking/live/servo_bench.h"
-#include "tracking/tracker/track_bench.h"
+#include "tracking/sim/sim_camera.h"
 
 namespace linetrack::app {
 namespace {
@@ -166,7 +166,8 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
 }
 
 nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop_reason) {
-  const double p50 = Quantile(s.loop_ms, 0.5), p95 = Quantile(s.loop_ms, 0.95);
+  const double p50 = QuantileNearestRank(s.loop_ms, 0.5),
+               p95 = QuantileNearestRank(s.loop_ms, 0.95);
   return {
       {"stop_reason", stop_reason},
       {"interrupted", stop_reason.rfind("signal", 0) == 0},

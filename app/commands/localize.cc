@@ -13,6 +13,7 @@
 #include "app/image_overlay.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "matching/evaluation/baseline_sampler.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 
@@ -44,7 +45,10 @@ LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   options.noise.focal_relative = opt.focal_error;
   std::string why;
   if (!options.noise.Check(&why)) throw InputError("--line-noise/--focal-error: " + why);
-  if (opt.method == "baseline") options.method = MatchMethod::kHypothesizeAndTest;
+  if (opt.method == "baseline") {
+    options.method = MatchMethod::kHypothesizeAndTest;
+    options.sampler = BaselineSampler(BaselineOptions());
+  }
   return options;
 }
 

@@ -15,6 +15,7 @@
 #include "models/camera.h"
 #include "models/geometry.h"
 #include "models/navigable_area.h"
+#include "models/statistics.h"
 #include "models/view_invariant_regions.h"
 #include "models/wireframe.h"
 
@@ -76,8 +77,7 @@ QueryStats BenchmarkQueries(const ViewInvariantRegions& regions, const Navigable
   stats.mean_kept = kept / opt.queries;
   stats.selectivity = stats.mean_kept / std::max(1, num_edges);
   stats.mean_us = std::accumulate(times_us.begin(), times_us.end(), 0.0) / times_us.size();
-  std::nth_element(times_us.begin(), times_us.begin() + times_us.size() / 2, times_us.end());
-  stats.median_us = times_us[times_us.size() / 2];
+  stats.median_us = QuantileNearestRank(times_us, 0.5);
   return stats;
 }
 

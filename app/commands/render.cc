@@ -22,6 +22,7 @@
 #include "models/render/png.h"
 #include "models/render/scene_renderer.h"
 #include "models/render/sequence.h"
+#include "models/statistics.h"
 #include "models/trajectory_io.h"
 #include "models/wireframe.h"
 
@@ -53,12 +54,6 @@ struct RenderCommandOptions {
 
 double Milliseconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 bool EndsWithPng(std::string name) {
@@ -157,8 +152,9 @@ int WriteSequence(const RenderCommandOptions& opt, const std::vector<SequenceFra
                         opt.undistorted ? camera.Undistorted() : camera);
   std::cout << "wrote " << frames.size() << " frames (" << camera.width << "x" << camera.height
             << ") to " << opt.out << ": median " << std::fixed << std::setprecision(1)
-            << Median(render_ms) << " ms per frame to render, " << Median(total_ms)
-            << " ms with PNG encoding and writing" << std::endl;
+            << QuantileNearestRank(render_ms, 0.5) << " ms per frame to render, "
+            << QuantileNearestRank(total_ms, 0.5) << " ms with PNG encoding and writing"
+            << std::endl;
   return kExitOk;
 }
 

@@ -17,7 +17,7 @@
 
 #include "app/commands.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 namespace {

@@ -19,7 +19,7 @@
 
 #include "models/trajectory_io.h"
 #include "tests/support/cli_test.h"
-#include "tracking/head/ptu_emulator.h"
+#include "tests/support/ptu_emulator.h"
 
 extern char** environ;
 

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "calibration/calibrate.h"
-#include "calibration/synthetic_board.h"
+#include "tests/support/synthetic_board.h"
 
 namespace linetrack {
 namespace {

@@ -1,5 +1,5 @@
 // Calibration against an exact ground truth: boards rendered by ray casting through a known
-// camera with ViSP's radial distortion (calibration/synthetic_board.h) from 15 seeded random
+// camera with ViSP's radial distortion (tests/support/synthetic_board.h) from 15 seeded random
 // poses, detected and calibrated as real images are; the recovered intrinsics are compared with
 // the truth.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "calibration/calibrate.h"
-#include "calibration/synthetic_board.h"
+#include "tests/support/synthetic_board.h"
 
 namespace linetrack {
 namespace {

@@ -6,11 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/render/scene_renderer.h"
 #include "models/robot_pose.h"
+#include "models/statistics.h"
 
 namespace linetrack {
 namespace {
@@ -55,12 +56,6 @@ struct Tally {
   std::vector<double> endpoint_errors;
 };
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 Tally DetectOnViews(const std::string& camera_file, LineDetectorKind detector) {
   const WireframeModel model = WireframeModel::Load(kHall);
   const OcclusionTester occlusion(model);
@@ -101,7 +96,7 @@ TEST_P(DetectorOnRenderedHall, FindsTheObservableModelEdges) {
     ASSERT_GT(tally.edges, 20);
     EXPECT_GE(tally.found, MinFoundShare(GetParam()) * tally.edges)
         << tally.found << " of " << tally.edges;
-    EXPECT_LE(Median(tally.endpoint_errors), kMaxMedianEndpointPx);
+    EXPECT_LE(QuantileNearestRank(tally.endpoint_errors, 0.5), kMaxMedianEndpointPx);
   }
 }
 

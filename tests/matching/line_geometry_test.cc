@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/hough_lines.h"
-#include "matching/lines/line_evaluation.h"
 #include "matching/lines/segment_fitting.h"
 #include "matching/lines/undistortion.h"
 

@@ -13,10 +13,10 @@
 #include <algorithm>
 #include <set>
 
-#include "matching/diagnosis.h"
+#include "matching/evaluation/diagnosis.h"
 #include "matching/interpretation_tree.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {

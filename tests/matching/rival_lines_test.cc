@@ -11,7 +11,7 @@
 
 #include "matching/pose_refinement.h"
 #include "matching/verification.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {

@@ -13,7 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "matching/unreported_doubt.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 namespace {

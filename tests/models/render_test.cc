@@ -12,6 +12,7 @@
 #include "models/geometry.h"
 #include "models/occlusion.h"
 #include "models/robot_pose.h"
+#include "models/statistics.h"
 
 namespace linetrack {
 namespace {
@@ -167,11 +168,6 @@ int DifferentPixels(const vpImage<unsigned char>& a, const vpImage<unsigned char
   return n;
 }
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 void ExpectStepsOnEdges(const std::string& camera_file, const RenderOptions& options,
                         double min_on_line_share, double max_median_px) {
   const WireframeModel model = WireframeModel::Load(kHall);
@@ -185,7 +181,7 @@ void ExpectStepsOnEdges(const std::string& camera_file, const RenderOptions& opt
     ASSERT_GT(stats.samples, 100);
     EXPECT_GE(stats.stepped, kMinStepShare * stats.samples);
     EXPECT_GE(stats.on_line, min_on_line_share * stats.stepped);
-    EXPECT_LT(Median(stats.errors), max_median_px);
+    EXPECT_LT(QuantileNearestRank(stats.errors, 0.5), max_median_px);
     if (distorted) {
       // Control: the distorted steps taken as undistorted pixels miss the projection.
       const EdgeStats raw = MeasureEdges(model, camera, pose, image, true, false);

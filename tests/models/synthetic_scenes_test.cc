@@ -1,7 +1,7 @@
 // Synthetic localisation scenes on the bundled hall: exact scenes lie on their model edges,
 // counts and priors respect their bounds, the noise has the configured statistics, and the
 // series is a pure function of the seed.
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -264,18 +264,6 @@ TEST(SyntheticNoise, PerturbRotatesAboutTheMidpointAndShiftsAlongTheNormal) {
   EXPECT_LT((p.Mid() - Eigen::Vector2d(145.0, 100.0)).norm(), 1e-9);
   EXPECT_NEAR(p.Length(), 100.0, 1e-9);
   EXPECT_NEAR(std::abs(p.a.x() - p.b.x()), 0.0, 1e-9);
-}
-
-TEST(SyntheticNoise, ClipKeepsThePartInsideTheImage) {
-  Segment2 s{{-100.0, 240.0}, {800.0, 240.0}};
-  ASSERT_TRUE(ClipSegmentToImage(640, 480, &s));
-  EXPECT_NEAR(s.a.x(), 0.0, 1e-9);
-  EXPECT_NEAR(s.b.x(), 639.0, 1e-9);
-  Segment2 outside{{-10.0, -10.0}, {-1.0, 500.0}};
-  EXPECT_FALSE(ClipSegmentToImage(640, 480, &outside));
-  Segment2 diagonal{{-50.0, -50.0}, {50.0, 50.0}};
-  ASSERT_TRUE(ClipSegmentToImage(640, 480, &diagonal));
-  EXPECT_LT(diagonal.a.norm(), 1e-9);
 }
 
 TEST(SyntheticNoise, FragmentShortensAndSplits) {

@@ -11,7 +11,7 @@
 
 #include "models/errors.h"
 #include "tracking/capture/aravis_source.h"
-#include "tracking/capture/fake_gige_camera.h"
+#include "tracking/fake_gige/fake_gige_camera.h"
 
 namespace linetrack {
 namespace {

@@ -11,7 +11,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "tracking/head/head_kinematics.h"
-#include "tracking/head/simulated_head.h"
+#include "tracking/sim/simulated_head.h"
 
 namespace linetrack {
 namespace {

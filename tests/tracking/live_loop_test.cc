@@ -14,13 +14,13 @@
 #include "models/geometry.h"
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
+#include "tests/support/ptu_emulator.h"
 #include "tracking/head/head_pointing.h"
 #include "tracking/head/ptu_driver.h"
-#include "tracking/head/ptu_emulator.h"
 #include "tracking/head/ptu_protocol.h"
 #include "tracking/live/live_loop.h"
-#include "tracking/live/sim_camera.h"
-#include "tracking/live/sim_rig.h"
+#include "tracking/sim/sim_camera.h"
+#include "tracking/sim/sim_rig.h"
 
 namespace linetrack {
 namespace {

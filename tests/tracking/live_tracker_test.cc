@@ -14,8 +14,8 @@
 #include "models/geometry.h"
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
-#include "tracking/live/sim_rig.h"
 #include "tracking/live/tracker_estimator.h"
+#include "tracking/sim/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
 namespace linetrack {

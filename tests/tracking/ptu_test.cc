@@ -7,10 +7,11 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "tests/support/ptu_emulator.h"
 #include "tracking/head/head_factory.h"
 #include "tracking/head/ptu_driver.h"
-#include "tracking/head/ptu_emulator.h"
 #include "tracking/head/ptu_protocol.h"
+#include "tracking/sim/simulated_head.h"
 
 namespace linetrack {
 namespace {
@@ -362,6 +363,8 @@ TEST(HeadFactory, OpensPtuAndSimulatedHeads) {
 
   HeadOptions options;
   options.ptu.reply_timeout_s = kReplyTimeoutS;
+  EXPECT_THROW(OpenHead("sim", options), InputError);  // no simulator given
+  options.make_sim = [] { return std::make_unique<SimulatedHead>(); };
   const auto sim = OpenHead("sim", options);
   EXPECT_NE(dynamic_cast<SimulatedHead*>(sim.get()), nullptr);
 

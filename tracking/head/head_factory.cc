@@ -22,7 +22,11 @@ HeadSpec ParseHeadSpec(const std::string& spec) {
 
 std::unique_ptr<PanTiltHead> OpenHead(const std::string& spec, const HeadOptions& options) {
   const HeadSpec parsed = ParseHeadSpec(spec);
-  if (parsed.kind == HeadKind::kSim) return std::make_unique<SimulatedHead>(options.sim);
+  if (parsed.kind == HeadKind::kSim) {
+    if (!options.make_sim)
+      throw InputError("--head " + spec + ": the simulated head is not available here");
+    return options.make_sim();
+  }
   PtuOptions ptu = options.ptu;
   ptu.device = parsed.device;
   HeadResult result;

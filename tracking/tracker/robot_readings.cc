@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "models/geometry.h"
+#include "models/statistics.h"
 
 namespace linetrack {
 
@@ -49,8 +50,7 @@ double MedianTimeStep(const std::vector<double>& times) {
   std::vector<double> steps;
   for (size_t i = 1; i < times.size(); ++i)
     steps.push_back(times[i] - times[i - 1]);
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  return steps[steps.size() / 2];
+  return QuantileNearestRank(steps, 0.5);
 }
 
 }  // namespace linetrack

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "models/errors.h"
+#include "models/statistics.h"
 
 namespace linetrack {
 
@@ -14,11 +15,6 @@ using Clock = std::chrono::steady_clock;
 
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double Median(std::deque<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
 }
 
 std::optional<KnownHeightTilt> Known(const std::optional<RobotReading>& robot) {
@@ -105,7 +101,7 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
   }
   if (problem.empty() &&
       recent_projection_errors_.size() * 3 >= static_cast<size_t>(options_.jump_window)) {
-    const double median = Median(recent_projection_errors_);
+    const double median = QuantileNearestRank(recent_projection_errors_, 0.5);
     const double limit = std::max(options_.jump_ratio * median, options_.jump_floor_deg);
     if (result.health.projection_error_deg > limit) {
       char text[128];
@@ -116,7 +112,7 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
   }
   if (problem.empty() && robot && result.health.refined &&
       recent_refined_rms_.size() * 3 >= static_cast<size_t>(options_.jump_window)) {
-    const double median = Median(recent_refined_rms_);
+    const double median = QuantileNearestRank(recent_refined_rms_, 0.5);
     const double limit = std::max(options_.rms_jump_ratio * median, options_.rms_jump_floor_px);
     if (result.health.refined_rms_after_px > limit) {
       char text[128];

@@ -11,11 +11,11 @@
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
-#include "tracking/live/sim_camera.h"
 #include "tracking/live/tracker_estimator.h"
 #include "tracking/servo/head_servo.h"
+#include "tracking/sim/sim_camera.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 struct ServoBenchOptions {
   double fps = 30.0;            // simulated frame rate
@@ -67,4 +67,4 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
                                          const CameraIntrinsics& camera,
                                          const ServoBenchOptions& options);
 
-}  // namespace linetrack
+}  // namespace linetrack::app

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "matching/localizer.h"
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack {
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "matching/interpretation_tree.h"
+#include "matching/localizer.h"
 #include "matching/verification.h"
 
 namespace linetrack {
@@ -31,5 +32,9 @@ std::vector<VerifiedPose> SampleAndVerify(const VerificationContext& context,
                                           const PriorRegion& prior, const BaselineOptions& options,
                                           const VerificationOptions& verification,
                                           BaselineStats* stats);
+
+// The baseline as the localizer's hypothesise-and-test sampler (LocalizerOptions::sampler, with
+// method kHypothesizeAndTest). Throws InputError when `options` are invalid.
+HypothesisSampler BaselineSampler(const BaselineOptions& options);
 
 }  // namespace linetrack

@@ -1,15 +1,15 @@
-#include "tracking/live/servo_bench.h"
+#include "app/bench/servo_bench.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "models/errors.h"
 #include "models/geometry.h"
-#include "tracking/live/sim_rig.h"
-#include "tracking/tracker/track_bench.h"
+#include "models/statistics.h"
+#include "tracking/sim/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
-namespace linetrack {
+namespace linetrack::app {
 namespace {
 
 constexpr double kConvergedPx = 2.0;
@@ -55,7 +55,7 @@ ServoBenchRun RunOne(const std::string& name, SimulatedLiveRig* rig,
     for (double e : settled)
       sum += e;
     run.mean_error_px = sum / settled.size();
-    run.p95_error_px = Quantile(settled, 0.95);
+    run.p95_error_px = QuantileNearestRank(settled, 0.95);
     run.max_error_px = *std::max_element(settled.begin(), settled.end());
   }
   return run;
@@ -129,4 +129,4 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
   return runs;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app

@@ -9,7 +9,7 @@
 #include "models/camera.h"
 #include "tracking/tracker/tracker_settings.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 // A recorded sequence with a start pose, as ViSP's samples provide them.
 struct BenchSequence {
@@ -54,7 +54,4 @@ struct TrackBenchResult {
 // is missing.
 TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats);
 
-// The q-quantile (0..1) of `values` (nearest rank); 0 for none.
-double Quantile(std::vector<double> values, double q);
-
-}  // namespace linetrack
+}  // namespace linetrack::app

@@ -1,20 +1,15 @@
-#include "tracking/capture/capture_bench.h"
+#include "app/bench/capture_bench.h"
 
 #include <algorithm>
 #include <chrono>
 #include <vector>
 
-namespace linetrack {
+#include "models/statistics.h"
+
+namespace linetrack::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const std::size_t k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
 
 }  // namespace
 
@@ -68,9 +63,9 @@ CaptureBenchResult RunCaptureBenchmark(FrameSource* source, const CaptureBenchOp
   result.underruns = after.underruns - before.underruns;
   result.mean_fps =
       result.elapsed_s > 0.0 ? static_cast<double>(result.frames) / result.elapsed_s : 0.0;
-  result.grab_ms_median = Percentile(grab_ms, 0.5);
-  result.grab_ms_p95 = Percentile(grab_ms, 0.95);
+  result.grab_ms_median = QuantileLowerRank(grab_ms, 0.5);
+  result.grab_ms_p95 = QuantileLowerRank(grab_ms, 0.95);
   return result;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app

@@ -1,4 +1,4 @@
-#include "calibration/synthetic_board.h"
+#include "tests/support/synthetic_board.h"
 
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/imgproc.hpp>

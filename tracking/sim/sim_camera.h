@@ -18,8 +18,8 @@
 #include "models/wireframe.h"
 #include "tracking/capture/frame_source.h"
 #include "tracking/head/head_kinematics.h"
-#include "tracking/head/simulated_head.h"
 #include "tracking/live/pose_estimator.h"
+#include "tracking/sim/simulated_head.h"
 
 namespace linetrack {
 

@@ -1,4 +1,4 @@
-#include "tracking/live/sim_rig.h"
+#include "tracking/sim/sim_rig.h"
 
 #include "models/errors.h"
 #include "tracking/head/head_pointing.h"

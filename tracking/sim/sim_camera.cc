@@ -1,4 +1,4 @@
-#include "tracking/live/sim_camera.h"
+#include "tracking/sim/sim_camera.h"
 
 #include <chrono>
 #include <cmath>

@@ -17,10 +17,11 @@
 
 #include "app/commands.h"
 #include "app/rendered_key_view.h"
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/views/view_positioning.h"
 #include "models/errors.h"
-#include "models/synthetic_scenes.h"
+#include "models/statistics.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 namespace {
@@ -36,12 +37,6 @@ struct BenchViewsOptions {
   bool render_db = false;
   std::string out_path;
 };
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
-}
 
 double Milliseconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
@@ -167,7 +162,8 @@ std::string RetrievalRow(const std::vector<Query>& queries, const ViewDatabase& 
       << " | " << 100.0 * nearest_first / n << " % | " << 100.0 * recall[0] / n << " % | "
       << 100.0 * recall[1] / n << " % | " << 100.0 * recall[2] / n << " % | " << none << " | "
       << true_pairs << " / " << pairs << " (" << 100.0 * true_pairs / std::max(1, pairs) << " %) | "
-      << std::setprecision(0) << Quantile(ms, 0.5) << " / " << Quantile(ms, 0.99) << " |\n";
+      << std::setprecision(0) << QuantileNearestRank(ms, 0.5) << " / "
+      << QuantileNearestRank(ms, 0.99) << " |\n";
   return row.str();
 }
 
@@ -189,10 +185,11 @@ std::string PositioningRow(const std::vector<Query>& queries, const ViewDatabase
   }
   std::ostringstream row;
   row << std::fixed << std::setprecision(2) << "| " << QueryKind(clutter) << " | " << queries.size()
-      << " | " << found << " | " << Quantile(error_all, 0.5) << " / " << Quantile(error_all, 0.9)
-      << " | " << valid << " | " << Quantile(error_valid, 0.5) << " / "
-      << Quantile(error_valid, 0.9) << " | " << Quantile(heading_valid, 0.5) << " | "
-      << std::setprecision(0) << Quantile(ms, 0.5) << " |\n";
+      << " | " << found << " | " << QuantileNearestRank(error_all, 0.5) << " / "
+      << QuantileNearestRank(error_all, 0.9) << " | " << valid << " | "
+      << QuantileNearestRank(error_valid, 0.5) << " / " << QuantileNearestRank(error_valid, 0.9)
+      << " | " << QuantileNearestRank(heading_valid, 0.5) << " | " << std::setprecision(0)
+      << QuantileNearestRank(ms, 0.5) << " |\n";
   return row.str();
 }
 
@@ -281,8 +278,9 @@ std::string SweepTable() {
         continue;
       }
       const SweepCell c = Sweep(z, d, seed++);
-      t << std::fixed << std::setprecision(2) << " " << Quantile(c.error_m, 0.5) << " m, "
-        << std::setprecision(0) << 100.0 * c.check_passed / std::max(1, c.trials) << " % |";
+      t << std::fixed << std::setprecision(2) << " " << QuantileNearestRank(c.error_m, 0.5)
+        << " m, " << std::setprecision(0) << 100.0 * c.check_passed / std::max(1, c.trials)
+        << " % |";
     }
     t << "\n";
   }

@@ -133,10 +133,6 @@ class SceneRandom {
 // it by `offset` pixels along its unit normal (direction rotated by +90 degrees).
 Segment2 PerturbSegment(const Segment2& s, double angle, double offset);
 
-// Clips `s` to the rectangle [0, width - 1] x [0, height - 1] (the image as ClipToFrustum sees
-// it); false when nothing is left.
-bool ClipSegmentToImage(double width, double height, Segment2* s);
-
 // Shortens `s` by the fractions `cut_a`, `cut_b` of its length at its two ends; when `gap` > 0
 // removes [split - gap / 2, split + gap / 2] (fractions of the original length) too, giving
 // two pieces. Pieces of non-positive length are dropped.

@@ -1,8 +1,10 @@
-#include "matching/baseline_sampler.h"
+#include "matching/evaluation/baseline_sampler.h"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
+
+#include "models/errors.h"
 
 namespace linetrack {
 
@@ -57,6 +59,19 @@ std::vector<VerifiedPose> SampleAndVerify(const VerificationContext& context,
     }
   }
   return verified;
+}
+
+HypothesisSampler BaselineSampler(const BaselineOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw InputError("localizer options: " + why);
+  return [options](const VerificationContext& context, const PriorRegion& prior,
+                   const VerificationOptions& verification, int* samples) {
+    BaselineStats stats;
+    std::vector<VerifiedPose> verified =
+        SampleAndVerify(context, prior, options, verification, &stats);
+    *samples = stats.samples;
+    return verified;
+  };
 }
 
 }  // namespace linetrack

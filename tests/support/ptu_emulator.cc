@@ -1,4 +1,4 @@
-#include "tracking/head/ptu_emulator.h"
+#include "tests/support/ptu_emulator.h"
 
 #include <fcntl.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "tracking/capture/fake_gige_camera.h"
+#include "tracking/fake_gige/fake_gige_camera.h"
 
 #include <arv.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "tracking/head/simulated_head.h"
+#include "tracking/sim/simulated_head.h"
 
 #include <algorithm>
 #include <cmath>

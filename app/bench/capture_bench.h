@@ -7,7 +7,7 @@
 
 #include "tracking/capture/frame_source.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 struct CaptureBenchOptions {
   double seconds = 5.0;         // how long to grab (files stop earlier at their end)
@@ -31,4 +31,4 @@ struct CaptureBenchResult {
 // Grabs from `source` for options.seconds (after the warm-up) and measures.
 CaptureBenchResult RunCaptureBenchmark(FrameSource* source, const CaptureBenchOptions& options);
 
-}  // namespace linetrack
+}  // namespace linetrack::app

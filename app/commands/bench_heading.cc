@@ -13,13 +13,14 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "matching/evaluation/line_evaluation.h"
 #include "matching/heading/heading_estimator.h"
-#include "matching/lines/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/navigable_area.h"
 #include "models/render/scene_renderer.h"
-#include "models/synthetic_scenes.h"
+#include "models/statistics.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 namespace {
@@ -113,12 +114,6 @@ double CandidateErrorDeg(const std::vector<double>& candidates, double truth) {
   return best;
 }
 
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
-}
-
 // One row of the table and the failures behind it.
 struct RowResult {
   int views = 0, eligible = 0, found = 0, within = 0, no_answer = 0, wrong_peak = 0, inaccurate = 0;
@@ -194,15 +189,15 @@ int RunBenchHeading(const BenchHeadingOptions& opt) {
       table << std::fixed << "| " << clutter << " | " << (tilt_known ? "given" : "estimated")
             << " | " << row.views << " | " << row.eligible << " | " << row.within << " ("
             << std::setprecision(1) << 100.0 * row.within / n << " %) | " << std::setprecision(3)
-            << Quantile(row.errors, 0.5) << " | " << Quantile(row.errors, 0.9) << " | "
+            << QuantileNearestRank(row.errors, 0.5) << " | " << QuantileNearestRank(row.errors, 0.9) << " | "
             << row.no_answer << " | " << row.wrong_peak << " | " << row.inaccurate << " | "
             << (tilt_known ? std::string("-") : [&] {
                  std::ostringstream s;
-                 s << std::fixed << std::setprecision(3) << Quantile(row.tilt_errors, 0.5);
+                 s << std::fixed << std::setprecision(3) << QuantileNearestRank(row.tilt_errors, 0.5);
                  return s.str();
                }())
-            << " | " << std::setprecision(2) << Quantile(row.ms, 0.5) << " / "
-            << Quantile(row.ms, 0.99) << " |\n";
+            << " | " << std::setprecision(2) << QuantileNearestRank(row.ms, 0.5) << " / "
+            << QuantileNearestRank(row.ms, 0.99) << " |\n";
       if (opt.verbose || (clutter == opt.clutter && tilt_known)) {
         failures << "\nFailures, " << clutter << " clutter objects, tilt "
                  << (tilt_known ? "given" : "estimated") << ":\n\n"

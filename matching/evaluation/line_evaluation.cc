@@ -1,4 +1,4 @@
-#include "matching/lines/line_evaluation.h"
+#include "matching/evaluation/line_evaluation.h"
 
 #include <algorithm>
 #include <cmath>

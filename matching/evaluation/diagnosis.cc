@@ -1,4 +1,4 @@
-#include "matching/diagnosis.h"
+#include "matching/evaluation/diagnosis.h"
 
 #include <algorithm>
 #include <cmath>

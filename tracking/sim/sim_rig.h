@@ -10,9 +10,9 @@
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/wireframe.h"
-#include "tracking/head/simulated_head.h"
 #include "tracking/live/live_loop.h"
-#include "tracking/live/sim_camera.h"
+#include "tracking/sim/sim_camera.h"
+#include "tracking/sim/simulated_head.h"
 
 namespace linetrack {
 

@@ -1,6 +1,6 @@
 // Synthetic localisation scenes: pose, projection with a calibration error, line noise and
 // fragmentation, clutter, prior, shuffle (docs/synth.md).
-#include "models/synthetic_scenes.h"
+#include "models/synth/synthetic_scenes.h"
 
 #include <algorithm>
 #include <cmath>

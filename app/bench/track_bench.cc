@@ -1,4 +1,4 @@
-#include "tracking/tracker/track_bench.h"
+#include "app/bench/track_bench.h"
 
 #include <visp3/core/vpException.h>
 #include <visp3/mbt/vpMbGenericTracker.h>
@@ -17,7 +17,7 @@
 #include "tracking/tracker/pose_file.h"
 #include "tracking/tracker/sequence_tracker.h"
 
-namespace linetrack {
+namespace linetrack::app {
 
 namespace {
 
@@ -105,14 +105,6 @@ std::vector<BenchSequence> VispBenchSequences(const std::string& visp_images,
   return sequences;
 }
 
-double Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const size_t k = std::min(values.size() - 1,
-                            static_cast<size_t>(std::max(0.0, q) * (values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
-
 TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats) {
   const std::vector<vpImage<unsigned char>> frames = LoadFrames(sequence.images);
   CameraIntrinsics camera = sequence.camera;
@@ -176,4 +168,4 @@ TrackBenchResult RunTrackBench(const BenchSequence& sequence, int repeats) {
   return result;
 }
 
-}  // namespace linetrack
+}  // namespace linetrack::app
