@@ -35,6 +35,7 @@ struct BenchHeadingOptions {
   int count = 200;
   uint64_t seed = 1;
   int clutter = 10;
+  int random_lines = 0;  // random segments added to the detected lines of the cluttered views
   std::string detector = LineDetectorName(LineExtractionOptions().detector);
   bool verbose = false;
   std::string out_path;
@@ -79,6 +80,20 @@ int LinesOfBestDirection(const WireframeModel& model, const ModelDirections& dir
   return counts.empty() ? 0 : *std::max_element(counts.begin(), counts.end());
 }
 
+// `count` random segments (20-200 px long, anywhere in the image) from the view's own stream.
+std::vector<Segment2> RandomLines(const CameraIntrinsics& camera, int count, SceneRandom* random) {
+  std::vector<Segment2> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Eigen::Vector2d mid(random->Uniform(0.0, camera.width),
+                              random->Uniform(0.0, camera.height));
+    const double angle = random->Uniform(0.0, kPi), half = 0.5 * random->Uniform(20.0, 200.0);
+    const Eigen::Vector2d d(half * std::cos(angle), half * std::sin(angle));
+    Segment2 s{mid - d, mid + d};
+    if (ClipSegmentToImage(camera.width, camera.height, &s) && s.Length() >= 20.0) out.push_back(s);
+  }
+  return out;
+}
+
 std::vector<HeadingView> RenderViews(const WireframeModel& model, const NavigableArea& area,
                                      const CameraIntrinsics& camera, const ModelDirections& dirs,
                                      const BenchHeadingOptions& opt, int clutter) {
@@ -98,6 +113,10 @@ std::vector<HeadingView> RenderViews(const WireframeModel& model, const Navigabl
     v.truth = DrawPose(area, &random);
     const Eigen::Isometry3d cam_from_world = CamFromWorld(v.truth);
     v.lines = extractor(renderer.Render(cam_from_world, i));
+    if (clutter > 0) {
+      for (const Segment2& s : RandomLines(undistorted, opt.random_lines, &random))
+        v.lines.push_back(s);
+    }
     v.lines_of_best_direction = LinesOfBestDirection(
         model, dirs, ProjectVisibleEdges(model, occlusion, cam_from_world, undistorted), v.lines);
     views.push_back(std::move(v));
@@ -186,7 +205,11 @@ int RunBenchHeading(const BenchHeadingOptions& opt) {
     for (bool tilt_known : {true, false}) {
       RowResult row = RunRow(views, camera.Undistorted(), dirs, tilt_known);
       const double n = std::max(1, row.eligible);
-      table << std::fixed << "| " << clutter << " | " << (tilt_known ? "given" : "estimated")
+      table << std::fixed << "| " << clutter
+            << (clutter > 0 && opt.random_lines > 0
+                    ? " + " + std::to_string(opt.random_lines) + " random lines"
+                    : "")
+            << " | " << (tilt_known ? "given" : "estimated")
             << " | " << row.views << " | " << row.eligible << " | " << row.within << " ("
             << std::setprecision(1) << 100.0 * row.within / n << " %) | " << std::setprecision(3)
             << QuantileNearestRank(row.errors, 0.5) << " | " << QuantileNearestRank(row.errors, 0.9) << " | "
@@ -233,11 +256,14 @@ void AddBenchHeading(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--detector", opt->detector, "Line detector: hough, lsd, fld, edlines")
       ->capture_default_str();
+  cmd->add_option("--random-lines", opt->random_lines,
+                  "Random segments (20-200 px) added to the lines of the cluttered views")
+      ->capture_default_str();
   cmd->add_flag("--verbose", opt->verbose, "List the failures of every row");
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->callback([opt, action] {
-    if (opt->count < 1 || opt->clutter < 0)
-      throw CLI::ValidationError("--count >= 1, --clutter >= 0");
+    if (opt->count < 1 || opt->clutter < 0 || opt->random_lines < 0)
+      throw CLI::ValidationError("--count >= 1, --clutter >= 0, --random-lines >= 0");
     *action = [opt] { return RunBenchHeading(*opt); };
   });
 }
