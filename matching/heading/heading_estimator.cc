@@ -24,6 +24,11 @@ bool HeadingOptions::Check(std::string* why) const {
     *why = "heading options: outlier_probability in (0, 1)";
     return false;
   }
+  if (!(line_angle_sigma_deg >= 0.0 && line_angle_sigma_deg < 90.0) ||
+      !(line_offset_sigma_px >= 0.0 && std::isfinite(line_offset_sigma_px))) {
+    *why = "heading options: line_angle_sigma_deg in [0, 90), line_offset_sigma_px finite >= 0";
+    return false;
+  }
   if (!std::isfinite(min_length_px) || min_length_px < 0.0 || min_support < 1 ||
       min_tilt_support < 1 || max_hypotheses < 1 || refine_iterations < 1 || refine_rounds < 1) {
     *why = "heading options: min_length_px >= 0; supports, hypotheses, iterations and rounds >= 1";

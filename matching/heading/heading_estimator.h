@@ -22,6 +22,11 @@ struct HeadingOptions {
   // Noise of a segment's endpoints across the segment (pixels): its angle has standard deviation
   // sqrt(2) sigma / length.
   double endpoint_sigma_px = 1.0;
+  // Noise of the whole line beside its endpoints' (0 for a detector's lines): a rotation about
+  // its midpoint (degrees) and a shift across it (pixels), both standard deviations, as in
+  // LineNoise; they add in quadrature to the endpoints' sqrt(2) sigma / length and sigma / sqrt(2).
+  double line_angle_sigma_deg = 0.0;
+  double line_offset_sigma_px = 0.0;
   // A segment points at a vanishing point when its angle to the direction toward it is within
   // max(gate_sigmas x its angle's standard deviation, min_gate_deg).
   double gate_sigmas = 3.0;

@@ -72,8 +72,10 @@ std::vector<VoteLine> PrepareVoteLines(const std::vector<Segment2>& lines,
     v.index = static_cast<int>(i);
     v.segment = s;
     v.normal = InterpretationNormal(camera, s);
-    v.angle_sigma = std::sqrt(2.0) * options.endpoint_sigma_px / length;
-    const double shift = options.endpoint_sigma_px / std::sqrt(2.0);
+    v.angle_sigma = std::hypot(std::sqrt(2.0) * options.endpoint_sigma_px / length,
+                               DegToRad(options.line_angle_sigma_deg));
+    const double shift =
+        std::hypot(options.endpoint_sigma_px / std::sqrt(2.0), options.line_offset_sigma_px);
     for (int k = 0; k < 2; ++k) {
       const double sign = k == 0 ? -1.0 : 1.0;
       v.turned[k] = InterpretationNormal(camera, Turned(s, sign * v.angle_sigma));
