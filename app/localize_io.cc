@@ -106,17 +106,20 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
     }
     c.problem.lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
   }
-  if (!json.contains("prior") || !json["prior"].is_array() || json["prior"].size() != 3 ||
-      !json["prior"][0].is_number() || !json["prior"][1].is_number() ||
-      !json["prior"][2].is_number()) {
+  c.problem.height = FiniteNumber(json, "height");
+  c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
+  if (!json.contains("prior") || json["prior"].is_null()) {
+    c.global = true;  // checked by the global localizer
+    return c;
+  }
+  if (!json["prior"].is_array() || json["prior"].size() != 3 || !json["prior"][0].is_number() ||
+      !json["prior"][1].is_number() || !json["prior"][2].is_number()) {
     throw InputError("key \"prior\" must be [x, y, heading_deg]");
   }
   c.problem.prior = {json["prior"][0].get<double>(), json["prior"][1].get<double>(),
                      DegToRad(json["prior"][2].get<double>())};
   c.problem.delta_t = FiniteNumber(json, "delta_t");
   c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
-  c.problem.height = FiniteNumber(json, "height");
-  c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
   CheckProblem(c.problem);
   return c;
 }
@@ -155,11 +158,36 @@ nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationRes
   return out;
 }
 
+nlohmann::ordered_json GlobalResultToJson(const std::string& id, const GlobalResult& result,
+                                          double time_ms) {
+  LocalizationResult shown = result.best;
+  if (!result.found) {
+    shown = LocalizationResult();
+    shown.reason = result.reason;
+    for (const HeadingSearch& s : result.searches)
+      shown.hypotheses += s.result.hypotheses;
+  }
+  nlohmann::ordered_json out = ResultToJson(id, shown, time_ms);
+  out["global"] = true;
+  out["ambiguous"] = result.ambiguous;
+  nlohmann::ordered_json rivals = nlohmann::ordered_json::array();
+  for (const Pose3Dof& p : result.rivals)
+    rivals.push_back({p.x, p.y, RadToDeg(WrapAngle(p.heading))});
+  out["rivals"] = rivals;
+  nlohmann::ordered_json headings = nlohmann::ordered_json::array();
+  for (const HeadingSearch& s : result.searches)
+    headings.push_back(RadToDeg(WrapAngle(s.heading)));
+  out["headings_deg"] = headings;
+  out["searches"] = result.searches.size();
+  return out;
+}
+
 const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
   auto it = models_.find(model_path);
   if (it != models_.end()) return it->second;
   LoadedModel loaded;
   loaded.model = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  loaded.directions = DominantDirections(*loaded.model);
   for (const std::string& w : loaded.model->warnings())
     spdlog::warn("{}", w);
   try {
@@ -190,6 +218,26 @@ const Localizer& LocalizerCache::Get(const std::string& model_path, const std::s
   auto localizer = std::make_unique<Localizer>(*model.model, model.regions.get(), model.area.get(),
                                                cam->second, options_);
   return *localizers_.emplace(key, std::move(localizer)).first->second;
+}
+
+const GlobalLocalizer& LocalizerCache::GetGlobal(const std::string& model_path,
+                                                 const std::string& camera_path,
+                                                 const std::string& camera_name) {
+  const std::string key = model_path + "\n" + camera_path + "\n" + camera_name;
+  auto it = globals_.find(key);
+  if (it != globals_.end()) return *it->second;
+  const Localizer& localizer = Get(model_path, camera_path, camera_name);
+  const LoadedModel& model = Model(model_path);
+  if (!model.area) {
+    throw InputError(model_path + ": the global mode needs a navigable area (" +
+                     model.area_problem + ")");
+  }
+  if (model.directions.angles.empty()) {
+    throw InputError(model_path + ": the global mode needs horizontal model edges");
+  }
+  auto global =
+      std::make_unique<GlobalLocalizer>(localizer, model.directions, GlobalOptionsFor(options_));
+  return *globals_.emplace(key, std::move(global)).first->second;
 }
 
 }  // namespace linetrack::app

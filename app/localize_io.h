@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "matching/global/global_localizer.h"
+#include "matching/heading/model_directions.h"
 #include "matching/localizer.h"
 #include "models/navigable_area.h"
 #include "models/view_invariant_regions.h"
@@ -22,11 +24,13 @@ struct BatchCase {
   std::string id;
   std::string model_path;  // resolved against the batch file's folder
   std::string camera_path;
-  std::string camera_name;  // optional "camera_name" key
-  LocalizationProblem problem;
+  std::string camera_name;      // optional "camera_name" key
+  LocalizationProblem problem;  // its prior, delta_t and delta_phi unset when global
+  bool global = false;          // no "prior" key, or "prior": null
 };
 
-// Parses one JSON line of a batch file; relative paths are resolved against `base_dir`.
+// Parses one JSON line of a batch file; relative paths are resolved against `base_dir`. A case
+// without "prior" (or with "prior": null) is global: delta_t and delta_phi are then ignored.
 // Throws InputError naming the missing or malformed key.
 BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir);
 
@@ -35,12 +39,19 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
 nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
                                     double time_ms);
 
+// The result of a global case: ResultToJson of the accepted search (or of the failure) with
+// "global": true, "ambiguous", the rival poses [x, y, heading_deg] when ambiguous, the heading
+// candidates (degrees) and the searches run.
+nlohmann::ordered_json GlobalResultToJson(const std::string& id, const GlobalResult& result,
+                                          double time_ms);
+
 // A model with what localisation needs beside it: navigable area (when derivable) and
 // view-invariant regions.
 struct LoadedModel {
   std::unique_ptr<WireframeModel> model;
   std::unique_ptr<NavigableArea> area;            // null when it cannot be derived
   std::unique_ptr<ViewInvariantRegions> regions;  // null without an area
+  ModelDirections directions;                     // dominant horizontal directions
   std::string area_problem;                       // why there is no area
 };
 
@@ -53,12 +64,17 @@ class LocalizerCache {
   const Localizer& Get(const std::string& model_path, const std::string& camera_path,
                        const std::string& camera_name);
   const LoadedModel& Model(const std::string& model_path);
+  // The global localizer of the model and camera. Throws InputError when the model has no
+  // navigable area or no horizontal direction.
+  const GlobalLocalizer& GetGlobal(const std::string& model_path, const std::string& camera_path,
+                                   const std::string& camera_name);
 
  private:
   LocalizerOptions options_;
   std::map<std::string, LoadedModel> models_;
   std::map<std::string, CameraIntrinsics> cameras_;
   std::map<std::string, std::unique_ptr<Localizer>> localizers_;
+  std::map<std::string, std::unique_ptr<GlobalLocalizer>> globals_;
 };
 
 }  // namespace linetrack::app

@@ -17,6 +17,8 @@
 #include "app/match_outcome.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/evaluation/diagnosis.h"
+#include "matching/global/global_localizer.h"
+#include "matching/heading/model_directions.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
 #include "models/statistics.h"
@@ -32,6 +34,8 @@ struct Series {
   // The paper's Table 3 for this prior (out of 430): correct, no answer, wrong but accurate,
   // wrong; negative when the paper has no such series.
   int paper[4] = {-1, -1, -1, -1};
+  // No prior: the scenes' priors are ignored and the global mode localises (docs/global.md).
+  bool global = false;
 };
 
 struct BenchMatchOptions {
@@ -53,7 +57,8 @@ Series SeriesByName(const std::string& name) {
   if (name == "qi2") return {"QI2 (0.50 m, 15 deg)", 0.50, 15.0, {418, 5, 7, 0}};
   if (name == "qi3") return {"QI3 (0.75 m, 20 deg)", 0.75, 20.0, {415, 5, 7, 3}};
   if (name == "wide") return {"wide (2.00 m, 45 deg)", 2.00, 45.0, {-1, -1, -1, -1}};
-  throw InputError("--series: unknown series '" + name + "' (qi1, qi2, qi3, wide)");
+  if (name == "global") return {"global (no prior)", 0.30, 10.0, {-1, -1, -1, -1}, true};
+  throw InputError("--series: unknown series '" + name + "' (qi1, qi2, qi3, wide, global)");
 }
 
 // Outcome counts and figures of one matcher on one series.
@@ -269,10 +274,46 @@ std::string Row(const std::string& matcher, const Tally& t) {
   return row.str();
 }
 
+// The global mode on a series' scenes, their priors ignored (scenes not in `only`, when given,
+// skipped): the tally and, in *ambiguous, the unanswered scenes answered "ambiguous".
+Tally RunGlobalSeries(const Localizer& tree, const ModelDirections& directions,
+                      const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
+                      int* ambiguous) {
+  const GlobalLocalizer global(tree, directions, GlobalOptionsFor(tree.options()));
+  Tally tally;
+  for (const SyntheticScene& scene : scenes) {
+    if (!only.empty() && std::find(only.begin(), only.end(), scene.index) == only.end()) continue;
+    const auto start = std::chrono::steady_clock::now();
+    const GlobalResult r = global.Localize({scene.lines, scene.height, scene.tilt});
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    LocalizationResult shown = r.found ? r.best : LocalizationResult();
+    shown.hypotheses = 0;
+    for (const HeadingSearch& h : r.searches)
+      shown.hypotheses += h.result.hypotheses;
+    Score(scene, shown, ms, &tally);
+    *ambiguous += r.ambiguous ? 1 : 0;
+  }
+  return tally;
+}
+
+// The table row of the global series, and its note (correct by the confidence region only,
+// ambiguous answers) appended to *notes.
+std::string GlobalRow(const Localizer& tree, const ModelDirections& directions,
+                      const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
+                      const std::string& name, std::ostringstream* notes) {
+  int ambiguous = 0;
+  const Tally t = RunGlobalSeries(tree, directions, scenes, only, &ambiguous);
+  *notes << (notes->tellp() > 0 ? "; " : "") << name << ": " << t.correct_beyond_tolerance
+         << " (no answer: " << ambiguous << " ambiguous)";
+  return "| " + name + " " + Row("heading + tree", t) + "\n";
+}
+
 int RunBenchMatch(const BenchMatchOptions& opt) {
   const WireframeModel model = WireframeModel::Load(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
+  const ModelDirections directions = DominantDirections(model);
   std::vector<Series> series;
   for (const std::string& name : opt.series)
     series.push_back(SeriesByName(name));
@@ -311,6 +352,10 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     baseline_sampling.max_samples = opt.baseline_samples;
     baseline_options.sampler = BaselineSampler(baseline_sampling);
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
+    if (s.global) {
+      table << GlobalRow(tree, directions, scenes, opt.only, s.name, &beyond);
+      continue;
+    }
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);
     Tally tree_tally, baseline_tally;
     std::map<std::string, int> categories;
@@ -382,7 +427,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--model", opt->model_path, "Model")->capture_default_str();
   cmd->add_option("--count", opt->count, "Scenes per series")->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the scenes")->capture_default_str();
-  cmd->add_option("--series", opt->series, "Priors: qi1 qi2 qi3 wide")->capture_default_str();
+  cmd->add_option("--series", opt->series, "Priors: qi1 qi2 qi3 wide, or global (no prior)")
+      ->capture_default_str();
   cmd->add_flag("!--no-baseline", opt->baseline, "Skip the baseline matcher");
   cmd->add_option("--baseline-samples", opt->baseline_samples,
                   "Random pairs the baseline may draw per case")

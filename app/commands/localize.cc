@@ -1,5 +1,5 @@
-// `linetrack localize`: camera pose from image line segments and a rough prior, one case from
-// flags or many from a JSON-lines batch file.
+// `linetrack localize`: camera pose from image line segments and a rough prior, or with no prior
+// at all (--global), one case from flags or many from a JSON-lines batch file.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -25,6 +25,7 @@ struct LocalizeOptions {
   double delta_t = 0.0, delta_phi_deg = 0.0, height = 0.0, tilt_deg = 0.0;
   std::string method = "tree";
   bool json = false;
+  bool global = false;  // no prior: heading candidates searched over the whole navigable area
   // From an image (--image) instead of --lines: the line extractor's flags and an overlay.
   std::string image_path, overlay_path;
   LineFlags lines;
@@ -78,6 +79,15 @@ int RunBatch(const LocalizeOptions& opt) {
         id = json["id"].is_string() ? json["id"].get<std::string>() : json["id"].dump();
       }
       BatchCase c = ParseBatchCase(json, base_dir);
+      if (c.global) {
+        const GlobalLocalizer& global = cache.GetGlobal(c.model_path, c.camera_path, c.camera_name);
+        const auto start = std::chrono::steady_clock::now();
+        const GlobalResult result =
+            global.Localize({c.problem.lines, c.problem.height, c.problem.tilt});
+        found += result.found ? 1 : 0;
+        std::cout << GlobalResultToJson(id, result, Milliseconds(start)).dump() << "\n";
+        continue;
+      }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
       const auto start = std::chrono::steady_clock::now();
       const LocalizationResult result = localizer.Localize(c.problem);
@@ -104,11 +114,29 @@ int RunBatch(const LocalizeOptions& opt) {
   return kExitOk;
 }
 
+// Prints an answer with no prior: the pose (PrintResult) or why none, with the rival poses.
+void PrintGlobal(const GlobalResult& global, double ms) {
+  std::cout << "global    " << global.searches.size() << " heading searches (";
+  for (size_t i = 0; i < global.searches.size(); ++i) {
+    std::cout << (i ? " " : "") << std::fixed << std::setprecision(1)
+              << RadToDeg(WrapAngle(global.searches[i].heading));
+  }
+  std::cout << " deg)\n";
+  if (global.found) return;
+  std::cout << "no pose: " << global.reason << " (" << std::setprecision(2) << ms << " ms)\n";
+  for (const Pose3Dof& p : global.rivals) {
+    std::cout << "rival     x " << std::setprecision(3) << p.x << " m, y " << p.y << " m, heading "
+              << std::setprecision(2) << RadToDeg(WrapAngle(p.heading)) << " deg\n";
+  }
+}
+
 int RunSingle(const LocalizeOptions& opt) {
   LocalizationProblem problem;
-  problem.prior = ParsePrior(opt.prior_text, "--prior");
-  problem.delta_t = opt.delta_t;
-  problem.delta_phi = DegToRad(opt.delta_phi_deg);
+  if (!opt.global) {
+    problem.prior = ParsePrior(opt.prior_text, "--prior");
+    problem.delta_t = opt.delta_t;
+    problem.delta_phi = DegToRad(opt.delta_phi_deg);
+  }
   problem.height = opt.height;
   problem.tilt = DegToRad(opt.tilt_deg);
   const std::string& source = opt.image_path.empty() ? opt.lines_path : opt.image_path;
@@ -120,19 +148,26 @@ int RunSingle(const LocalizeOptions& opt) {
   } else {
     problem.lines = ReadLinesCsv(opt.lines_path);
   }
-  try {
-    if (!problem.lines.empty()) CheckProblem(problem);
-  } catch (const InputError& e) {
-    throw InputError(source + ": " + e.what());
-  }
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
+  const GlobalLocalizer* global =
+      opt.global ? &cache.GetGlobal(opt.model_path, opt.camera_path, opt.camera_name) : nullptr;
   const auto start = std::chrono::steady_clock::now();
   LocalizationResult result;
-  if (problem.lines.empty()) {
-    result.reason = "no line segments in the image";  // an image may show none: not bad input
-  } else {
-    result = localizer.Localize(problem);
+  std::optional<GlobalResult> global_result;
+  try {
+    if (problem.lines.empty()) {
+      result.reason = "no line segments in the image";  // an image may show none: not bad input
+    } else if (global) {
+      global_result = global->Localize({problem.lines, problem.height, problem.tilt});
+      result = global_result->found ? global_result->best : LocalizationResult();
+      result.reason = global_result->reason;
+    } else {
+      CheckProblem(problem);
+      result = localizer.Localize(problem);
+    }
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
   }
   const double ms = Milliseconds(start);
   if (image && !opt.overlay_path.empty()) {
@@ -144,9 +179,11 @@ int RunSingle(const LocalizeOptions& opt) {
     std::cout << "lines     " << image->segments.size() << " segments (" << image->detector << ", "
               << std::fixed << std::setprecision(2) << image->ms << " ms)\n";
   }
+  if (global_result && !opt.json) PrintGlobal(*global_result, ms);
   if (opt.json) {
+    const std::string id = std::filesystem::path(source).stem().string();
     nlohmann::ordered_json json =
-        ResultToJson(std::filesystem::path(source).stem().string(), result, ms);
+        global_result ? GlobalResultToJson(id, *global_result, ms) : ResultToJson(id, result, ms);
     if (image) {
       json["lines"] = image->segments.size();
       json["lines_ms"] = image->ms;
@@ -162,7 +199,7 @@ int RunSingle(const LocalizeOptions& opt) {
     std::cout << ")\nscore     " << result.score_px << " px, support " << result.support
               << "\nsearch    " << result.candidate_edges << " candidate edges, "
               << result.hypotheses << " hypotheses, " << ms << " ms\n";
-  } else {
+  } else if (!global_result) {
     std::cout << "no pose: " << result.reason << " (" << result.hypotheses << " hypotheses, "
               << std::fixed << std::setprecision(2) << ms << " ms)\n";
   }
@@ -194,6 +231,9 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
                   "Relative focal-length uncertainty of the camera file")
       ->capture_default_str();
   cmd->add_option("--prior", opt->prior_text, "Prior pose X,Y,HEADING_DEG (metres, degrees)");
+  cmd->add_flag("--global", opt->global,
+                "No prior: anywhere in the navigable area, any heading, instead of --prior, "
+                "--delta-t and --delta-phi (docs/global.md)");
   cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)");
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
@@ -208,8 +248,15 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       *action = [opt] { return RunBatch(*opt); };
       return;
     }
-    for (const char* flag :
-         {"--model", "--camera", "--prior", "--delta-t", "--delta-phi", "--height", "--tilt"}) {
+    for (const char* flag : {"--prior", "--delta-t", "--delta-phi"}) {
+      if (opt->global && cmd->count(flag) > 0) {
+        throw CLI::ValidationError(std::string(flag), "is not given with --global");
+      }
+      if (!opt->global && cmd->count(flag) == 0) {
+        throw CLI::RequiredError(std::string(flag) + " is required without --batch or --global");
+      }
+    }
+    for (const char* flag : {"--model", "--camera", "--height", "--tilt"}) {
       if (cmd->count(flag) == 0) {
         throw CLI::RequiredError(std::string(flag) + " is required without --batch");
       }
