@@ -2,13 +2,19 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include "models/camera_file.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 
@@ -50,6 +56,35 @@ void CheckRange(double value, double lo, double hi, const std::string& flag) {
     std::ostringstream msg;
     msg << flag << ": " << value << " is outside [" << lo << ", " << hi << "]";
     throw InputError(msg.str());
+  }
+}
+
+void CheckTimesOverlap(const std::vector<double>& times, double first, double last,
+                       double tolerance, const std::string& what) {
+  if (times.empty()) return;
+  const auto [lo, hi] = std::minmax_element(times.begin(), times.end());
+  if (*hi >= first - tolerance && *lo <= last + tolerance) return;
+  std::ostringstream msg;
+  msg << std::fixed << std::setprecision(3) << what << ": its times " << *lo << "-" << *hi
+      << " s do not overlap the frames' times " << first << "-" << last
+      << " s (give --time-offset SECONDS, or --align-times)";
+  throw InputError(msg.str());
+}
+
+void CheckHeight(double metres, const std::string& flag) {
+  if (!std::isfinite(metres) || metres <= 0.0 || metres > 100.0) {
+    std::ostringstream msg;
+    msg << flag << ": " << metres
+        << " is not a camera height (metres above the floor: more than 0, at most 100)";
+    throw InputError(msg.str());
+  }
+}
+
+void RefuseUnless(const CLI::App& cmd, bool applies, const std::vector<std::string>& flags,
+                  const std::string& why) {
+  if (applies) return;
+  for (const std::string& flag : flags) {
+    if (cmd.count(flag) > 0) throw CLI::ValidationError(flag, why);
   }
 }
 
@@ -127,6 +162,24 @@ void EnsureDirectory(const std::string& dir) {
   if (!std::filesystem::is_directory(dir, ec)) {
     throw InputError(dir + ": cannot create the output folder");
   }
+}
+
+CameraIntrinsics LoadCamera(const std::string& path, const std::string& name) {
+  const CameraFile file = ReadCameraFile(path, name);
+  if (file.format != CameraFileFormat::kVispXml && !file.brown_conrady.IsZero()) {
+    // A pixel error of this size would bias the tracked poses: say so louder.
+    constexpr double kLoudErrorPx = 1.0;
+    const std::string text = fmt::format(
+        "{}: {}: its distortion (k1 k2 p1 p2 k3) is used as ViSP's one-term model (kud {:.5f}, "
+        "kdu {:.5f}), within {:.2f} px over the image",
+        path, ToString(file.format), file.camera.kud, file.camera.kdu, file.approximation_px);
+    if (file.approximation_px > kLoudErrorPx) {
+      spdlog::warn("{}; a ViSP calibration (calibrate's camera.xml) fits the images better", text);
+    } else {
+      spdlog::info("{}", text);
+    }
+  }
+  return file.camera;
 }
 
 }  // namespace linetrack::app

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "models/camera.h"
 #include "models/robot_pose.h"
 
 namespace linetrack::app {
@@ -35,6 +36,21 @@ std::vector<double> ParseNumbers(const std::string& text, int count, const std::
 // Throws InputError unless `value` is finite and within [lo, hi] (names `flag`).
 void CheckRange(double value, double lo, double hi, const std::string& flag);
 
+// Throws InputError (naming `what`, e.g. "x.csv: --prior-file") unless some of `times` (seconds,
+// already shifted by any --time-offset) fall within [first - tolerance, last + tolerance], the
+// frames' times: a file stamped in another time base (epoch seconds against frames from 0).
+void CheckTimesOverlap(const std::vector<double>& times, double first, double last,
+                       double tolerance, const std::string& what);
+
+// Throws InputError unless `metres` is a camera height above the floor: finite, positive and at
+// most 100 m (names `flag`).
+void CheckHeight(double metres, const std::string& flag);
+
+// Refuses the flags that cannot apply: throws CLI::ValidationError "FLAG: WHY" for the first of
+// `flags` given on `cmd` when `applies` is false, so that no flag is silently ignored.
+void RefuseUnless(const CLI::App& cmd, bool applies, const std::vector<std::string>& flags,
+                  const std::string& why);
+
 // Writes `content` to `path` through a temporary file renamed into place, so that a reader never
 // sees a partial file. Throws InputError when the file cannot be written.
 void WriteFileAtomically(const std::string& path, const std::string& content);
@@ -60,6 +76,11 @@ class StopSignals {
   struct Saved;
   std::unique_ptr<Saved> saved_;
 };
+
+// The camera of `path`: a ViSP camera XML, an OpenCV calibration file or a ROS camera_info YAML
+// (ReadCamera, models/camera_file.h). Says on stderr how closely ViSP's one-term distortion
+// stands for the Brown-Conrady distortion of an OpenCV or ROS file. Throws InputError.
+CameraIntrinsics LoadCamera(const std::string& path, const std::string& name = "");
 
 // Creates `dir` (and parents) when missing; throws InputError when it cannot.
 void EnsureDirectory(const std::string& dir);

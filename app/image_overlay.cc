@@ -64,15 +64,23 @@ void DrawSegments(vpImage<vpRGBa>* image, const std::vector<Segment2>& segments,
   }
 }
 
+namespace {
+
+// ViSP's default font at `height` pixels, its monospace font where the default is missing.
+std::unique_ptr<vpFont> MakeFont(unsigned int height) {
+  try {
+    return std::make_unique<vpFont>(height);
+  } catch (const vpException&) {
+    return std::make_unique<vpFont>(height, vpFont::GENERIC_MONOSPACE);
+  }
+}
+
+}  // namespace
+
 void DrawTextBox(vpImage<vpRGBa>* image, const std::vector<std::string>& lines) {
   constexpr unsigned int kTextHeight = 14;
   constexpr int kMargin = 4;
-  std::unique_ptr<vpFont> font;
-  try {
-    font = std::make_unique<vpFont>(kTextHeight);
-  } catch (const vpException&) {
-    font = std::make_unique<vpFont>(kTextHeight, vpFont::GENERIC_MONOSPACE);
-  }
+  const std::unique_ptr<vpFont> font = MakeFont(kTextHeight);
   double width = 0.0;
   for (const std::string& line : lines)
     width = std::max(width, font->getMeasure(line).get_u());
@@ -84,6 +92,23 @@ void DrawTextBox(vpImage<vpRGBa>* image, const std::vector<std::string>& lines) 
   for (size_t k = 0; k < lines.size(); ++k) {
     font->drawText(*image, lines[k], vpImagePoint(kMargin + k * line_height, kMargin),
                    vpColor::white);
+  }
+}
+
+void DrawLabels(vpImage<vpRGBa>* image, const std::vector<ImageLabel>& labels,
+                const vpColor& colour) {
+  constexpr unsigned int kTextHeight = 11;
+  constexpr double kMargin = 2.0;
+  const std::unique_ptr<vpFont> font = MakeFont(kTextHeight);
+  const double w = image->getWidth(), h = image->getHeight();
+  for (const ImageLabel& label : labels) {
+    const double text_w = font->getMeasure(label.text).get_u();
+    const double box_w = text_w + 2 * kMargin, box_h = kTextHeight + 2 * kMargin;
+    if (box_w >= w || box_h >= h) continue;
+    const double left = std::clamp(label.at.x() + 4.0, 0.0, w - 1 - box_w);
+    const double top = std::clamp(label.at.y() - box_h / 2, 0.0, h - 1 - box_h);
+    vpImageDraw::drawRectangle(*image, vpRect(left, top, box_w, box_h), vpColor(30, 30, 30), true);
+    font->drawText(*image, label.text, vpImagePoint(top + kMargin, left + kMargin), colour);
   }
 }
 

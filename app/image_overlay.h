@@ -31,6 +31,15 @@ void DrawSegments(vpImage<vpRGBa>* image, const std::vector<Segment2>& segments,
 // A box of text lines (white on a dark background) at the top-left corner.
 void DrawTextBox(vpImage<vpRGBa>* image, const std::vector<std::string>& lines);
 
+// A small label (`colour` on a dark background) beside each image point (column, row), kept
+// inside the image.
+struct ImageLabel {
+  std::string text;
+  Eigen::Vector2d at;
+};
+void DrawLabels(vpImage<vpRGBa>* image, const std::vector<ImageLabel>& labels,
+                const vpColor& colour);
+
 // The PNG file content of a colour image.
 std::string EncodePngColour(const vpImage<vpRGBa>& image);
 

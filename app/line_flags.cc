@@ -41,13 +41,14 @@ LineExtractionOptions LineFlags::Options() const {
 
 std::optional<CameraIntrinsics> LineFlags::Camera() const {
   if (camera_path.empty()) return std::nullopt;
-  return ReadCameraXml(camera_path, camera_name);
+  return LoadCamera(camera_path, camera_name);
 }
 
 void AddLineFlags(CLI::App* cmd, LineFlags* flags, bool with_camera) {
   if (with_camera) {
-    cmd->add_option("--camera", flags->camera_path,
-                    "ViSP camera XML: segments are undistorted with its radial model");
+    cmd->add_option(
+        "--camera", flags->camera_path,
+        "Camera file (ViSP XML, OpenCV or ROS YAML): segments are undistorted with its model");
     cmd->add_option("--camera-name", flags->camera_name, "Camera name in the XML (default: first)");
   }
   cmd->add_option("--detector", flags->detector, "Line detector: hough, lsd, fld, edlines")

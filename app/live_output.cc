@@ -44,18 +44,19 @@ void Open(const fs::path& path, const std::string& header, std::ofstream* out) {
 }  // namespace
 
 const char* const kLiveCsvHeader =
-    "frame,t,grab,status,source,pan_deg,tilt_deg,pan_rate_deg_s,tilt_rate_deg_s,command,"
+    "frame,t,grab,status,state,source,pan_deg,tilt_deg,pan_rate_deg_s,tilt_rate_deg_s,command,"
     "cmd_pan_rate_deg_s,cmd_tilt_rate_deg_s,error_u_px,error_v_px,error_px,gain,converged,"
     "saturated,limited,compensated,prior_x,prior_y,prior_heading_deg,prior_tilt_deg,estimate_ms,"
-    "loop_ms,note";
+    "loop_ms,sigma_x_m,sigma_y_m,sigma_heading_deg,protection_level_m,protection_level_deg,note";
 
 std::string LiveCsvRow(const LiveIteration& it) {
   char numbers[512];
   std::snprintf(
       numbers, sizeof(numbers),
-      "%lld,%.6f,%s,%s,%s,%.4f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.3f,%.3f,%.3f,%.4f,%d,%d,%d,%d,"
+      "%lld,%.6f,%s,%s,%s,%s,%.4f,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.3f,%.3f,%.3f,%.4f,%d,%d,%d,%d,"
       "%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,",
-      static_cast<long long>(it.frame), it.t, ToString(it.grab), ToString(it.estimate.status),
+      static_cast<long long>(it.frame), it.t, ToString(it.grab),
+      ToString(it.estimate.uncertainty.status), ToString(it.estimate.status),
       CsvField(it.estimate.source).c_str(), RadToDeg(it.head.pan), RadToDeg(it.head.tilt),
       RadToDeg(it.head.pan_rate), RadToDeg(it.head.tilt_rate), ToString(it.command),
       RadToDeg(it.servo.pan_rate), RadToDeg(it.servo.tilt_rate), it.servo.error_u_px,
@@ -64,13 +65,17 @@ std::string LiveCsvRow(const LiveIteration& it) {
       RadToDeg(it.camera_prior.heading), RadToDeg(it.camera_prior.tilt), it.estimate_ms,
       it.loop_ms);
   std::string note = it.note;
+  if (note.empty() && it.estimate.uncertainty.status != IntegrityStatus::kTracking) {
+    note = it.estimate.note.empty() ? it.estimate.uncertainty.reason : it.estimate.note;
+  }
   if (it.command != HeadCommand::kNone && !it.command_result.ok()) {
     note += (note.empty() ? "" : "; ") + std::string("head: ") + it.command_result.message;
   }
-  return numbers + CsvField(note);
+  return numbers + IntegrityCsvFields(it.estimate.uncertainty) + "," + CsvField(note);
 }
 
-LiveOutput::LiveOutput(const std::string& dir, bool with_truth) : dir_(dir) {
+LiveOutput::LiveOutput(const std::string& dir, bool with_truth, bool all_poses)
+    : dir_(dir), all_poses_(all_poses) {
   EnsureDirectory(dir);
   const fs::path root(dir);
   std::error_code ec;
@@ -78,6 +83,7 @@ LiveOutput::LiveOutput(const std::string& dir, bool with_truth) : dir_(dir) {
   fs::remove(root / "summary.json", ec);
   fs::remove(root / "truth.txt", ec);
   Open(root / "frames.csv", kLiveCsvHeader, &frames_);
+  covariance_ = std::make_unique<CovarianceLog>(dir);
   Open(root / "poses.txt", "# t x y z qx qy qz qw (world_from_cam, ViSP camera axes)", &poses_);
   if (with_truth) {
     Open(root / "truth.txt", "# t x y z qx qy qz qw (world_from_cam, ViSP camera axes)", &truth_);
@@ -87,7 +93,9 @@ LiveOutput::LiveOutput(const std::string& dir, bool with_truth) : dir_(dir) {
 void LiveOutput::Add(const LiveIteration& it, const Eigen::Isometry3d* true_cam_from_world) {
   frames_ << LiveCsvRow(it) << "\n";
   frames_.flush();
-  if (it.estimate.has_pose()) {
+  covariance_->Add(static_cast<long>(it.frame), it.t, it.estimate.uncertainty);
+  if (it.estimate.has_pose() &&
+      (all_poses_ || it.estimate.uncertainty.status == IntegrityStatus::kTracking)) {
     poses_ << TumLine(it.t, *it.estimate.cam_from_world);
     poses_.flush();
   }

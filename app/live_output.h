@@ -9,14 +9,16 @@
 
 #include <Eigen/Geometry>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/integrity_output.h"
 #include "tracking/live/live_loop.h"
 
 namespace linetrack::app {
 
-// The header of frames.csv.
+// The header of frames.csv (status: tracking, degraded, lost; state: the tracker's).
 extern const char* const kLiveCsvHeader;
 
 // One row of frames.csv for `it` (angles and rates in degrees, errors in pixels, times in ms).
@@ -26,9 +28,11 @@ class LiveOutput {
  public:
   // Creates `dir` and its files with their headers (replacing those of an earlier run). Throws
   // InputError when the folder or a file cannot be written.
-  LiveOutput(const std::string& dir, bool with_truth);
+  // poses.txt holds the poses tracking, or all of them with `all_poses`.
+  LiveOutput(const std::string& dir, bool with_truth, bool all_poses);
 
-  // Appends the iteration's row (and its pose, and the true pose when given); flushed.
+  // Appends the iteration's row and covariance line (and its pose, and the true pose when
+  // given); flushed.
   void Add(const LiveIteration& it, const Eigen::Isometry3d* true_cam_from_world);
 
   // Writes snapshots/frame_NNNNN.png (atomically: a temporary name renamed into place).
@@ -42,6 +46,8 @@ class LiveOutput {
  private:
   std::string dir_;
   std::ofstream frames_, poses_, truth_;
+  std::unique_ptr<CovarianceLog> covariance_;
+  bool all_poses_ = false;
 };
 
 }  // namespace linetrack::app

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "app/head_mount.h"
 #include "models/errors.h"
 #include "tracking/capture/source_factory.h"
 #include "tracking/head/head_factory.h"
@@ -43,6 +44,12 @@ Pose3Dof PriorAt(const std::vector<PriorRecord>& priors, double t) {
 }
 
 LiveSession::LiveSession(const LivePlan& plan, const LiveInputs& inputs) {
+  const BelievedHead believed =
+      BelieveHead(plan.head_model, inputs.mount, inputs.mount_path, plan.height);
+  mount_ = believed.description;
+  LiveLoopOptions loop = plan.loop;
+  loop.servo.geometry = believed.geometry;
+  loop.crossing_height = believed.crossing_height;
   if (plan.use_tracker) {
     if (inputs.area == nullptr) throw InputError("live: the tracker needs the navigable area");
     tracker_ = std::make_unique<TrackerPoseEstimator>(*inputs.model, *inputs.area, inputs.camera,
@@ -58,15 +65,17 @@ LiveSession::LiveSession(const LivePlan& plan, const LiveInputs& inputs) {
       if (!head.Check(&why)) throw InputError("--head-start: " + why);
     }
     start.offset_from_target = plan.head_start_offset;
-    rig_ = std::make_unique<SimulatedLiveRig>(*inputs.model, inputs.area, inputs.camera,
-                                              plan.sim_camera, head, plan.loop, start,
-                                              PoseJitterOptions{}, tracker_.get());
+    rig_ = std::make_unique<SimulatedLiveRig>(
+        *inputs.model, inputs.area, inputs.camera,
+        SimulatedLiveRigOptions{plan.sim_camera, head, loop, start, PoseJitterOptions{}},
+        tracker_.get());
     return;
   }
-  OpenDevices(plan, inputs);
+  OpenDevices(plan, loop, inputs);
 }
 
-void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
+void LiveSession::OpenDevices(const LivePlan& plan, const LiveLoopOptions& loop,
+                              const LiveInputs& inputs) {
   // Cameras are set to the calibrated image size (and frame rate when asked).
   FrameSourceOptions sources;
   sources.aravis.width = inputs.camera.width;
@@ -75,14 +84,14 @@ void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
   sources.aravis.latest_only = true;  // the servo acts on the newest frame, never a backlog
   source_ = OpenFrameSource(plan.source_spec, sources);
   head_ = OpenHead(plan.head_spec, HeadOptions{});
-  const HeadGeometry geometry = GeometryOf(plan.head_model);
-  const double crossing = CrossingHeightFor(geometry, plan.height);
+  const HeadGeometry& geometry = loop.servo.geometry;
+  const double crossing = loop.crossing_height;
   const Pose3Dof base = plan.prior ? *plan.prior : PriorAt(inputs.priors, 0.0);
   if (plan.head_start) MoveHeadAndWait(head_.get(), plan.head_start->x(), plan.head_start->y());
   if (plan.head_start_offset) {
     double pan = 0.0, tilt = 0.0;
-    if (!HeadAnglesLookingAt(geometry, WorldFromHeadBase(base, crossing), *plan.loop.target, &pan,
-                             &tilt)) {
+    if (!HeadAnglesLookingAt(geometry, WorldFromHeadBase(geometry, base, crossing), *loop.target,
+                             &pan, &tilt)) {
       throw InputError("--head-start-offset: the target is too close to the head to look at");
     }
     MoveHeadAndWait(head_.get(), pan + plan.head_start_offset->x(),
@@ -100,10 +109,9 @@ void LiveSession::OpenDevices(const LivePlan& plan, const LiveInputs& inputs) {
       return PriorAt(priors, t - **first_t);
     };
   }
-  LiveLoopOptions options = plan.loop;
-  options.crossing_height = crossing;
-  loop_ = std::make_unique<LiveLoop>(source_.get(), head_.get(), tracker_.get(), odometry,
-                                     *inputs.model, inputs.camera.Undistorted(), options);
+  loop_ = std::make_unique<LiveLoop>(
+      LiveLoopParts{source_.get(), head_.get(), tracker_.get(), odometry}, *inputs.model,
+      inputs.camera.Undistorted(), loop);
 }
 
 LiveSession::~LiveSession() = default;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/mount_file.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/trajectory_io.h"
@@ -27,7 +28,8 @@ struct LivePlan {
   bool sim = false;
   SimCameraOptions sim_camera;  // sim only
   HeadModel head_model = HeadModel::kPtu46;
-  double height = 1.3;            // camera height with the head level (metres)
+  // Camera height with the head level (metres); none: the --mount file's floor calibration.
+  std::optional<double> height;
   std::optional<Pose3Dof> prior;  // the robot base (x, y, heading)
   LiveLoopOptions loop;
   std::optional<Eigen::Vector2d> head_start, head_start_offset;
@@ -43,6 +45,8 @@ struct LiveInputs {
   const NavigableArea* area = nullptr;  // for the tracker's matcher and the simulated loop
   std::vector<PriorRecord> priors;      // --prior-file: base odometry (t from the first frame)
   TrackerEstimatorOptions tracker;
+  std::optional<MountFile> mount;  // --mount: the calibrated mount instead of the nominal one
+  std::string mount_path;
 };
 
 // The base pose of `priors` at time t (seconds from the first frame): the last row at or before
@@ -61,17 +65,20 @@ class LiveSession {
   std::string DescribeSource() const;
   std::string DescribeHead() const;
   std::string DescribeEstimator() const;
+  // The head geometry the loop believes (nominal or calibrated, and where its height came from).
+  const std::string& DescribeMount() const { return mount_; }
   // Simulation: the true camera pose of the last frame; null for real devices.
   const Eigen::Isometry3d* truth() const;
 
  private:
-  void OpenDevices(const LivePlan& plan, const LiveInputs& inputs);
+  void OpenDevices(const LivePlan& plan, const LiveLoopOptions& loop, const LiveInputs& inputs);
 
   std::unique_ptr<TrackerPoseEstimator> tracker_;
   std::unique_ptr<SimulatedLiveRig> rig_;  // simulation
   std::unique_ptr<FrameSource> source_;    // real devices
   std::unique_ptr<PanTiltHead> head_;
   std::unique_ptr<LiveLoop> loop_;
+  std::string mount_;
 };
 
 }  // namespace linetrack::app

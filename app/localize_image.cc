@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "app/cli_common.h"
 #include "app/image_overlay.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
@@ -16,7 +17,7 @@ ImageLines ExtractImageLines(const std::string& image_path, const std::string& c
                              const std::string& camera_name, const LineFlags& flags) {
   const LineExtractionOptions options = flags.Options();
   ImageLines lines;
-  lines.camera = ReadCameraXml(camera_path, camera_name);
+  lines.camera = LoadCamera(camera_path, camera_name);
   lines.detector = LineDetectorName(options.detector);
   lines.image = ReadGreyImage(image_path);
   LineExtractor extractor(options, lines.camera);
@@ -52,11 +53,17 @@ std::string LocalizationOverlayPng(const ImageLines& lines, const WireframeModel
     undistorted.width = static_cast<int>(lines.image.getWidth());
     undistorted.height = static_cast<int>(lines.image.getHeight());
     std::vector<Segment2> projected;
+    std::vector<ImageLabel> names;  // each matched edge's name at its middle
     for (const ProjectedEdge& e :
          ProjectVisibleEdges(model, occlusion, result.cam_from_world, undistorted)) {
-      if (matched_edges.count(e.edge_id) > 0) projected.push_back(e.image);
+      if (matched_edges.count(e.edge_id) == 0) continue;
+      projected.push_back(e.image);
+      const std::string& name = model.edges().at(static_cast<size_t>(e.edge_id)).name;
+      names.push_back({name.empty() ? "edge " + std::to_string(e.edge_id) : name,
+                       lines.camera.Distort(0.5 * (e.image.a + e.image.b))});
     }
     DrawSegments(&picture, projected, vpColor::green, 2, lines.camera);
+    DrawLabels(&picture, names, vpColor::green);
     pose << "x " << result.pose.x << " m, y " << result.pose.y << " m, heading "
          << RadToDeg(WrapAngle(result.pose.heading)) << " deg";
     matches << result.matches.size() << " correspondences, score " << std::setprecision(2)

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/cli_common.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace linetrack::app {
@@ -83,9 +85,7 @@ std::vector<Segment2> ReadLinesCsv(const std::string& path) {
 BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir) {
   if (!json.is_object()) throw InputError("a case must be a JSON object");
   BatchCase c;
-  c.id = json.contains("id") && json["id"].is_string() ? json["id"].get<std::string>()
-         : json.contains("id")                         ? json["id"].dump()
-                                                       : "";
+  if (json.contains("id")) c.id = json["id"];
   c.model_path = Resolve(Required<std::string>(json, "model"), base_dir);
   c.camera_path = Resolve(Required<std::string>(json, "camera"), base_dir);
   if (json.contains("camera_name")) c.camera_name = Required<std::string>(json, "camera_name");
@@ -107,6 +107,16 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
     c.problem.lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
   }
   c.problem.height = FiniteNumber(json, "height");
+  if (c.problem.height <= 0.0) {
+    throw InputError("key \"height\" is not a camera height (metres above the floor, > 0)");
+  }
+  if (json.contains("storey")) {
+    if (!json["storey"].is_number_integer() || json["storey"].get<int>() < 0) {
+      throw InputError("key \"storey\" must be an integer >= 0");
+    }
+    c.storey = json["storey"].get<int>();
+  }
+  if (json.contains("floor_z")) c.floor_z = FiniteNumber(json, "floor_z");
   c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
   if (!json.contains("prior") || json["prior"].is_null()) {
     c.global = true;  // checked by the global localizer
@@ -124,8 +134,18 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
   return c;
 }
 
-nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
-                                    double time_ms) {
+double CameraZ(const WireframeModel& model, double height, int storey, double floor_z) {
+  if (std::isfinite(floor_z)) return floor_z + height;
+  const int s = std::max(storey, 0);
+  if (s >= static_cast<int>(model.storeys().size())) {
+    throw InputError("storey " + std::to_string(s) + ": " + model.path() + " has " +
+                     std::to_string(model.storeys().size()) + " storeys (0 is the lowest)");
+  }
+  return model.storeys()[s].floor_z + height;
+}
+
+nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const LocalizationResult& result,
+                                    double time_ms, const WireframeModel* model) {
   nlohmann::ordered_json out;
   out["id"] = id;
   out["found"] = result.found;
@@ -151,6 +171,12 @@ nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationRes
   for (const auto& [edge, line] : result.matches)
     matches.push_back({edge, line});
   out["matches"] = matches;
+  if (model) {
+    nlohmann::ordered_json names = nlohmann::ordered_json::array();
+    for (const auto& match : result.matches)
+      names.push_back(model->edges().at(static_cast<size_t>(match.first)).name);
+    out["edge_names"] = names;
+  }
   out["hypotheses"] = result.hypotheses;
   out["candidate_edges"] = result.candidate_edges;
   out["tree_nodes"] = result.tree_nodes;
@@ -158,8 +184,8 @@ nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationRes
   return out;
 }
 
-nlohmann::ordered_json GlobalResultToJson(const std::string& id, const GlobalResult& result,
-                                          double time_ms) {
+nlohmann::ordered_json GlobalResultToJson(const nlohmann::json& id, const GlobalResult& result,
+                                          double time_ms, const WireframeModel* model) {
   LocalizationResult shown = result.best;
   if (!result.found) {
     shown = LocalizationResult();
@@ -167,12 +193,14 @@ nlohmann::ordered_json GlobalResultToJson(const std::string& id, const GlobalRes
     for (const HeadingSearch& s : result.searches)
       shown.hypotheses += s.result.hypotheses;
   }
-  nlohmann::ordered_json out = ResultToJson(id, shown, time_ms);
+  nlohmann::ordered_json out = ResultToJson(id, shown, time_ms, model);
   out["global"] = true;
   out["ambiguous"] = result.ambiguous;
+  if (!result.found) out["answer"] = result.ambiguous ? "ambiguous" : "none";
   nlohmann::ordered_json rivals = nlohmann::ordered_json::array();
-  for (const Pose3Dof& p : result.rivals)
-    rivals.push_back({p.x, p.y, RadToDeg(WrapAngle(p.heading))});
+  for (const Pose3Dof& p : result.rivals) {
+    rivals.push_back({{"x", p.x}, {"y", p.y}, {"heading_deg", RadToDeg(WrapAngle(p.heading))}});
+  }
   out["rivals"] = rivals;
   nlohmann::ordered_json headings = nlohmann::ordered_json::array();
   for (const HeadingSearch& s : result.searches)
@@ -186,10 +214,8 @@ const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
   auto it = models_.find(model_path);
   if (it != models_.end()) return it->second;
   LoadedModel loaded;
-  loaded.model = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  loaded.model = std::make_unique<WireframeModel>(LoadModel(model_path));
   loaded.directions = DominantDirections(*loaded.model);
-  for (const std::string& w : loaded.model->warnings())
-    spdlog::warn("{}", w);
   try {
     loaded.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*loaded.model));
     loaded.regions = std::make_unique<ViewInvariantRegions>(
@@ -210,7 +236,7 @@ const Localizer& LocalizerCache::Get(const std::string& model_path, const std::s
   const std::string camera_key = camera_path + "\n" + camera_name;
   auto cam = cameras_.find(camera_key);
   if (cam == cameras_.end()) {
-    cam = cameras_.emplace(camera_key, ReadCameraXml(camera_path, camera_name)).first;
+    cam = cameras_.emplace(camera_key, LoadCamera(camera_path, camera_name)).first;
   }
   if (cam->second.width <= 0) {
     throw InputError(Located(camera_path, 0, "the camera file gives no image size"));

@@ -2,6 +2,7 @@
 // JSON, plus a cache that loads each model and camera once.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -21,11 +22,16 @@ std::vector<Segment2> ReadLinesCsv(const std::string& path);
 
 // One case of a batch file (see docs/matching.md for the format).
 struct BatchCase {
-  std::string id;
+  nlohmann::json id;       // the case's "id" as given (a string, a number...); null without one
   std::string model_path;  // resolved against the batch file's folder
   std::string camera_path;
-  std::string camera_name;      // optional "camera_name" key
-  LocalizationProblem problem;  // its prior, delta_t and delta_phi unset when global
+  std::string camera_name;  // optional "camera_name" key
+  // Which floor "height" is measured from: the optional "storey" key (an index into the model's
+  // storeys; -1: not given, storey 0) or "floor_z" (world z, metres; NaN: not given).
+  int storey = -1;
+  double floor_z = std::numeric_limits<double>::quiet_NaN();
+  LocalizationProblem problem;  // problem.height: above that floor until CameraZ() is applied;
+                                // its prior, delta_t and delta_phi unset when global
   bool global = false;          // no "prior" key, or "prior": null
 };
 
@@ -34,16 +40,21 @@ struct BatchCase {
 // Throws InputError naming the missing or malformed key.
 BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir);
 
-// The result of one case as a JSON object: id, found, pose, cMo, matches, score, hypotheses,
-// time_ms (and diagnostics: candidate_edges, tree_nodes, reason).
-nlohmann::ordered_json ResultToJson(const std::string& id, const LocalizationResult& result,
-                                    double time_ms);
+// World z of a camera `height` metres above the floor of `storey` (-1: storey 0) of `model`, or
+// above `floor_z` when finite. Throws InputError when the storey does not exist.
+double CameraZ(const WireframeModel& model, double height, int storey, double floor_z);
+
+// The result of one case as a JSON object: id (as given), found, pose, cMo, matches ([edge,
+// line] pairs), score, hypotheses, time_ms (and diagnostics: candidate_edges, tree_nodes,
+// reason); with `model`, also edge_names: the name of each match's edge ("" when unnamed).
+nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const LocalizationResult& result,
+                                    double time_ms, const WireframeModel* model = nullptr);
 
 // The result of a global case: ResultToJson of the accepted search (or of the failure) with
-// "global": true, "ambiguous", the rival poses [x, y, heading_deg] when ambiguous, the heading
-// candidates (degrees) and the searches run.
-nlohmann::ordered_json GlobalResultToJson(const std::string& id, const GlobalResult& result,
-                                          double time_ms);
+// "global": true, "ambiguous", "answer" ("ambiguous" or "none") when no pose, the rival poses
+// ({x, y, heading_deg} each) when ambiguous, the heading candidates (degrees) and the searches.
+nlohmann::ordered_json GlobalResultToJson(const nlohmann::json& id, const GlobalResult& result,
+                                          double time_ms, const WireframeModel* model = nullptr);
 
 // A model with what localisation needs beside it: navigable area (when derivable) and
 // view-invariant regions.

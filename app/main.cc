@@ -11,6 +11,9 @@
 #include <opencv2/core/version.hpp>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
+#include "app/ros/bag_recording.h"
+#include "app/ros/ros_commands.h"
 #include "models/errors.h"
 
 namespace {
@@ -38,9 +41,14 @@ int main(int argc, char** argv) {
       "linetrack"};
   cli.set_version_flag("--version", VersionText(), "Print the version and exit");
   cli.require_subcommand(1);
-  cli.fallthrough(false);
+  // Global flags (--quiet, --strict) are accepted after the subcommand too: its subcommands
+  // (inheriting this) hand the options they do not know up to here.
+  cli.fallthrough(true);
   bool quiet = false;
   cli.add_flag("-q,--quiet", quiet, "Only errors on stderr");
+  bool strict = false;
+  cli.add_flag("--strict", strict,
+               "Refuse a model the checks find fault with (exit 2) instead of warning");
 
   app::CommandAction action;
   app::AddModelInfo(cli, &action);
@@ -55,9 +63,17 @@ int main(int argc, char** argv) {
   app::AddLines(cli, &action);
   app::AddBenchLocalizeImage(cli, &action);
   app::AddBenchTrack(cli, &action);
-  app::AddReplay(cli, &action);
+  app::AddBenchDrive(cli, &action);
+  app::AddReplayWithRecordings(cli, &action, app::OpenRosBag);
   app::AddLive(cli, &action);
   app::AddBenchServo(cli, &action);
+  app::AddRos(cli, &action);
+  app::AddBenchRos(cli, &action);
+  app::AddCalibrateMount(cli, &action);
+  app::AddMakeBuilding(cli, &action);
+  app::AddModelImport(cli, &action);
+  app::AddBenchBuilding(cli, &action);
+  app::AddBenchMount(cli, &action);
   app::AddHeading(cli, &action);
   app::AddBenchHeading(cli, &action);
   app::AddViews(cli, &action);
@@ -71,6 +87,7 @@ int main(int argc, char** argv) {
     return app::kExitBadInput;
   }
   if (quiet) spdlog::set_level(spdlog::level::err);
+  app::SetStrictModelChecks(strict);
   try {
     return action ? action() : app::kExitBadInput;
   } catch (const InputError& e) {

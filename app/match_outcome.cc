@@ -1,8 +1,10 @@
 #include "app/match_outcome.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "models/geometry.h"
 
@@ -49,6 +51,18 @@ MatchOutcome JudgeMatch(bool found, bool reported_correspondences_all_true,
   const bool accurate = errors.WithinTolerance() || errors.mahalanobis2 <= kOwnRegionChi2;
   if (!accurate) return MatchOutcome::kWrong;
   return reported_correspondences_all_true ? MatchOutcome::kCorrect : MatchOutcome::kWrongAccurate;
+}
+
+bool ReportedMatchesTrue(const std::vector<std::pair<int, int>>& truth,
+                         const std::vector<std::pair<int, int>>& reported) {
+  const std::set<std::pair<int, int>> known(truth.begin(), truth.end());
+  return !reported.empty() && std::all_of(reported.begin(), reported.end(),
+                                          [&](const auto& m) { return known.count(m) > 0; });
+}
+
+MatchOutcome JudgeScene(const SyntheticScene& scene, const LocalizationResult& result) {
+  return JudgeMatch(result.found, ReportedMatchesTrue(scene.matches, result.matches),
+                    ErrorsOf(result.pose.Planar(), result.covariance, scene.truth.Planar()));
 }
 
 }  // namespace linetrack::app

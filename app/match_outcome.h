@@ -4,7 +4,12 @@
 
 #include <Eigen/Core>
 
+#include <utility>
+#include <vector>
+
+#include "matching/localizer.h"
 #include "models/robot_pose.h"
+#include "models/synth/synthetic_scenes.h"
 
 namespace linetrack::app {
 
@@ -41,5 +46,12 @@ PoseErrors ErrorsOf(const Pose3Dof& answer, const Eigen::Matrix3d& covariance,
 // weakly observed pose that says so is not a wrong claim; one that claims more is).
 MatchOutcome JudgeMatch(bool found, bool reported_correspondences_all_true,
                         const PoseErrors& errors);
+
+// True when `reported` (model edge id, line index) pairs are not empty and all in `truth`.
+bool ReportedMatchesTrue(const std::vector<std::pair<int, int>>& truth,
+                         const std::vector<std::pair<int, int>>& reported);
+
+// JudgeMatch of a localisation of a synthetic scene against the scene's ground truth.
+MatchOutcome JudgeScene(const SyntheticScene& scene, const LocalizationResult& result);
 
 }  // namespace linetrack::app

@@ -38,18 +38,13 @@ nlohmann::ordered_json Statistics(const std::vector<double>& values) {
           {"max", values.empty() ? 0.0 : *std::max_element(values.begin(), values.end())}};
 }
 
-cv::Scalar StatusColour(TrackStatus status) {
-  switch (status) {
-    case TrackStatus::kTracking:
-      return {0, 200, 0};
-    case TrackStatus::kRelocalised:
-      return {255, 200, 0};
-    case TrackStatus::kLost:
-      return {0, 0, 255};
-    case TrackStatus::kInitialising:
-      break;
+cv::Scalar StatusColour(const FrameReport& report) {
+  if (!report.cam_from_world) {
+    return report.status == TrackStatus::kInitialising ? cv::Scalar(0, 200, 255)
+                                                       : cv::Scalar(0, 0, 255);
   }
-  return {0, 200, 255};
+  return report.uncertainty.status == IntegrityStatus::kTracking ? cv::Scalar(0, 200, 0)
+                                                                 : cv::Scalar(0, 140, 255);
 }
 
 void Text(cv::Mat* image, const std::string& text, cv::Point at, cv::Scalar colour) {
@@ -59,38 +54,43 @@ void Text(cv::Mat* image, const std::string& text, cv::Point at, cv::Scalar colo
 
 }  // namespace
 
-ReplayLog::ReplayLog(const std::string& dir, bool with_ground_truth)
-    : with_ground_truth_(with_ground_truth) {
+ReplayLog::ReplayLog(const std::string& dir, bool with_ground_truth, bool all_poses)
+    : covariance_(dir), with_ground_truth_(with_ground_truth), all_poses_(all_poses) {
   const std::string poses_path = dir + "/poses.txt", frames_path = dir + "/frames.csv";
   poses_.open(poses_path, std::ios::trunc);
   frames_.open(frames_path, std::ios::trunc);
   if (!poses_ || !frames_) throw InputError(dir + ": cannot write poses.txt and frames.csv");
   poses_ << FormatTum({}) << std::flush;
-  frames_ << "frame,time,status,projection_error_deg,moving_edges,time_ms,source,passes";
+  frames_ << "frame,time,status,projection_error_deg,moving_edges,time_ms,source,passes,state,"
+          << kIntegrityCsvColumns;
   if (with_ground_truth_) frames_ << ",translation_error_m,rotation_error_deg";
   frames_ << ",note\n" << std::flush;
 }
 
 void ReplayLog::Add(const ReplayFrameRecord& record, const FrameReport& report) {
-  if (report.cam_from_world) {
+  const PoseUncertainty& u = report.uncertainty;
+  if (report.cam_from_world && (all_poses_ || u.status == IntegrityStatus::kTracking)) {
     StampedPose pose;
     pose.t = record.t;
     pose.world_from_cam = report.cam_from_world->inverse();
     const std::string text = FormatTum({pose});
     poses_ << text.substr(text.find('\n') + 1) << std::flush;
   }
-  std::string note = report.note;
+  // The note: why there is no pose, else why the pose is not tracking.
+  std::string note = report.note.empty() ? u.reason : report.note;
   std::replace(note.begin(), note.end(), ',', ';');
   std::replace(note.begin(), note.end(), '\n', ' ');
-  frames_ << record.frame << "," << Fixed(record.t, 6) << "," << ToString(record.status) << ","
+  frames_ << record.frame << "," << Fixed(record.t, 6) << "," << ToString(u.status) << ","
           << (report.health_measured ? Fixed(record.projection_error_deg, 3) : "") << ","
           << (report.health_measured ? std::to_string(record.edges_good) : "") << ","
-          << Fixed(record.step_ms, 3) << "," << report.source << "," << report.health.passes;
+          << Fixed(record.step_ms, 3) << "," << report.source << "," << report.health.passes << ","
+          << ToString(record.status) << "," << IntegrityCsvFields(u);
   if (with_ground_truth_) {
     frames_ << "," << (record.translation_error_m ? Fixed(*record.translation_error_m, 5) : "")
             << "," << (record.rotation_error_deg ? Fixed(*record.rotation_error_deg, 4) : "");
   }
   frames_ << "," << note << "\n" << std::flush;
+  covariance_.Add(record.frame, record.t, u);
 }
 
 OverlayWriter::OverlayWriter(const std::string& dir, bool png_frames, double fps, cv::Size size)
@@ -146,14 +146,16 @@ cv::Mat DrawOverlay(const vpImage<unsigned char>& undistorted,
                      const_cast<unsigned char*>(undistorted.bitmap));
   cv::Mat bgr;
   cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
-  const cv::Scalar colour = StatusColour(report.status);
+  const cv::Scalar colour = StatusColour(report);
+  const PoseUncertainty& u = report.uncertainty;
   for (const Segment2& s : model_edges) {
     cv::line(bgr, cv::Point2d(s.a.x(), s.a.y()), cv::Point2d(s.b.x(), s.b.y()), colour, 1,
              cv::LINE_AA);
   }
   Text(&bgr,
-       "frame " + std::to_string(frame) + "  t " + Fixed(t, 2) + " s  " + ToString(report.status) +
-           (report.source.empty() ? "" : " (" + report.source + ")"),
+       "frame " + std::to_string(frame) + "  t " + Fixed(t, 2) + " s  " + ToString(u.status) +
+           "  [" + ToString(report.status) + (report.source.empty() ? "" : ", " + report.source) +
+           "]",
        {8, 18}, colour);
   if (report.cam_from_world) {
     const RobotPose p = RobotPoseFromCamFromWorld(*report.cam_from_world);
@@ -167,6 +169,15 @@ cv::Mat DrawOverlay(const vpImage<unsigned char>& undistorted,
              std::to_string(report.health.edges_good) + "/" +
              std::to_string(report.health.edges_total) + " moving edges",
          {8, 58}, colour);
+    if (u.has_covariance()) {
+      Text(&bgr,
+           "sigma x " + Fixed(u.sigma_x_m * 100.0, 1) + " y " + Fixed(u.sigma_y_m * 100.0, 1) +
+               " cm  heading " + Fixed(RadToDeg(u.sigma_heading_rad), 2) + " deg  PL " +
+               Fixed(u.protection_position_m * 100.0, 1) + " cm / " +
+               Fixed(RadToDeg(u.protection_rotation_rad), 2) + " deg",
+           {8, 78}, colour);
+    }
+    if (u.status != IntegrityStatus::kTracking) Text(&bgr, u.reason.substr(0, 90), {8, 98}, colour);
   } else {
     Text(&bgr, report.note.substr(0, 90), {8, 38}, colour);
   }
@@ -272,7 +283,8 @@ nlohmann::ordered_json ReplaySummary(const std::vector<ReplayFrameRecord>& recor
       {"throughput_fps", n / busy_s},
       {"wall_s", info.wall_s},
       {"overlay_s", info.overlay_s},
-      {"overlay", {{"path", info.overlay_path}, {"codec", info.overlay_codec}}}};
+      {"overlay", {{"path", info.overlay_path}, {"codec", info.overlay_codec}}},
+      {"integrity", info.integrity}};
   if (!translation.empty()) {
     double sum_squares = 0.0;
     for (double e : translation)

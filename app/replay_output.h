@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "app/integrity_output.h"
 #include "tracking/tracker/sequence_tracker.h"
 
 namespace linetrack::app {
@@ -30,19 +31,22 @@ struct ReplayFrameRecord {
   std::optional<double> rotation_error_deg;
 };
 
-// poses.txt and frames.csv, each line flushed as soon as its frame is done, so that an
-// interrupted replay leaves valid files up to the last frame.
+// poses.txt (the poses `tracking`, or all with `all_poses`), frames.csv (status: tracking,
+// degraded, lost; state: the tracker's) and covariance.jsonl, each line flushed as soon as its
+// frame is done, so that an interrupted replay leaves valid files up to the last frame.
 class ReplayLog {
  public:
-  // Creates both files in `dir` (which must exist); throws InputError when it cannot.
-  ReplayLog(const std::string& dir, bool with_ground_truth);
+  // Creates the files in `dir` (which must exist); throws InputError when it cannot.
+  ReplayLog(const std::string& dir, bool with_ground_truth, bool all_poses);
 
   void Add(const ReplayFrameRecord& record, const FrameReport& report);
 
  private:
   std::ofstream poses_;
   std::ofstream frames_;
+  CovarianceLog covariance_;
   bool with_ground_truth_;
+  bool all_poses_;
 };
 
 // The overlay video: H.264 in .mp4 ('avc1'), else MPEG-4 part 2 ('mp4v'), else Motion-JPEG in
@@ -67,8 +71,9 @@ class OverlayWriter {
 };
 
 // The overlay of one frame: the undistorted image, the visible model edges at the reported pose
-// (green while tracking, cyan when relocalised), a status line and the pose (x, y, z, heading,
-// tilt) or why there is none.
+// (green while tracking, orange when degraded), a status line (the integrity status and the
+// tracker's state), the pose (x, y, z, heading, tilt) with its sigmas and protection levels, or
+// why there is none.
 cv::Mat DrawOverlay(const vpImage<unsigned char>& undistorted,
                     const std::vector<Segment2>& model_edges, const FrameReport& report, long frame,
                     double t);
@@ -86,10 +91,12 @@ struct ReplayRunInfo {
   double overlay_s = 0.0;    // drawing and encoding the overlay (excluded from throughput)
   std::string overlay_path, overlay_codec, error_plot;
   int losses = 0, recoveries = 0;
+  nlohmann::ordered_json integrity;  // IntegrityTally::Summary
 };
 
 // summary.json: frames, tracked share, losses and recoveries, status counts, timing percentiles,
-// throughput; with ground truth the ATE (RMSE of the camera centre errors) and error statistics.
+// throughput, the integrity (info.integrity); with ground truth the ATE (RMSE of the camera
+// centre errors) and error statistics.
 nlohmann::ordered_json ReplaySummary(const std::vector<ReplayFrameRecord>& records,
                                      const ReplayRunInfo& info);
 

@@ -19,16 +19,6 @@ std::string Format(const char* format, double a, double b = 0.0, double c = 0.0)
   return buffer;
 }
 
-BoardView MakeView(const std::string& name, const PatternDetection& d,
-                   const std::vector<Eigen::Vector3d>& board) {
-  BoardView view;
-  view.name = name;
-  view.image_points = d.image_points;
-  for (int id : d.point_ids)
-    view.board_points.push_back(board[static_cast<size_t>(id)]);
-  return view;
-}
-
 }  // namespace
 
 const char* ToString(ViewStatus status) {
@@ -74,16 +64,21 @@ std::vector<CalibrationImage> LoadCalibrationImages(const std::vector<std::strin
   return images;
 }
 
-bool CalibrationOptions::Check(std::string* why) const {
-  if (!pattern.Check(why) || !detection.Check(why) || !visp.Check(why)) return false;
-  if (!(outlier_factor > 1.0) || !std::isfinite(outlier_factor)) {
+bool CheckOutlierRule(double factor, double min_error_px, std::string* why) {
+  if (!(factor > 1.0) || !std::isfinite(factor)) {
     *why = "--outlier-factor must be a finite number above 1";
     return false;
   }
-  if (!(outlier_min_error_px >= 0.0) || !std::isfinite(outlier_min_error_px)) {
+  if (!(min_error_px >= 0.0) || !std::isfinite(min_error_px)) {
     *why = "--outlier-min-error must be a finite number >= 0";
     return false;
   }
+  return true;
+}
+
+bool CalibrationOptions::Check(std::string* why) const {
+  if (!pattern.Check(why) || !detection.Check(why) || !visp.Check(why)) return false;
+  if (!CheckOutlierRule(outlier_factor, outlier_min_error_px, why)) return false;
   if (min_views < 3) {
     *why = "at least 3 views are needed to calibrate";
     return false;
@@ -143,10 +138,7 @@ CalibrationResult CalibrateDetections(const std::vector<std::string>& names,
   }
   if (found == 0) {
     result.status = CalibrationStatus::kPatternNeverFound;
-    result.message = std::string("the ") + ToString(options.pattern.kind) + " pattern (" +
-                     std::to_string(options.pattern.cols) + "x" +
-                     std::to_string(options.pattern.rows) + ") was found in none of the " +
-                     std::to_string(detections.size()) + " images";
+    result.message = PatternNeverFoundMessage(options.pattern, detections.size());
     return result;
   }
   while (true) {
@@ -155,7 +147,7 @@ CalibrationResult CalibrateDetections(const std::vector<std::string>& names,
     for (size_t i = 0; i < result.views.size(); ++i) {
       if (result.views[i].status != ViewStatus::kUsed) continue;
       used.push_back(i);
-      views.push_back(MakeView(result.views[i].name, result.views[i].detection, board));
+      views.push_back(ViewOfDetection(result.views[i].name, result.views[i].detection, board));
     }
     if (static_cast<int>(views.size()) < options.min_views) {
       result.status = CalibrationStatus::kTooFewViews;

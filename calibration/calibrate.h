@@ -92,4 +92,8 @@ CalibrationResult Calibrate(const std::vector<CalibrationImage>& images,
 // factor * median(errors) and min_error_px. Pure function of the per-view errors.
 int FindOutlierView(const std::vector<double>& errors, double factor, double min_error_px);
 
+// The outlier rule's settings are usable: factor finite and above 1, min_error_px finite and
+// >= 0; otherwise false with *why naming the flag (--outlier-factor, --outlier-min-error).
+bool CheckOutlierRule(double factor, double min_error_px, std::string* why);
+
 }  // namespace linetrack

@@ -117,6 +117,16 @@ bool DetectionOptions::Check(std::string* why) const {
   return true;
 }
 
+BoardView ViewOfDetection(const std::string& name, const PatternDetection& detection,
+                          const std::vector<Eigen::Vector3d>& board) {
+  BoardView view;
+  view.name = name;
+  view.image_points = detection.image_points;
+  for (int id : detection.point_ids)
+    view.board_points.push_back(board[static_cast<size_t>(id)]);
+  return view;
+}
+
 PatternDetection DetectPattern(const cv::Mat& gray, const PatternSpec& pattern,
                                const DetectionOptions& options) {
   PatternDetection detection;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/board_view.h"
 #include "calibration/pattern.h"
 
 namespace linetrack {
@@ -38,8 +39,13 @@ struct PatternDetection {
 
 // The cornerSubPix half window used for a board whose nearest corners are `min_spacing_px`
 // apart: the configured one, shrunk to round(spacing / 2) (at least 2) so that the window never
-// takes in the neighbouring corners (an 11 px half window on 14 px squares errs by up to 6 px).
+// takes in the neighbouring corners, which would pull the corner off by pixels.
 int SubpixHalfWindow(int configured, double min_spacing_px);
+
+// The view a detection gives: its points and the board points of their ids (`board` =
+// BoardPoints(pattern)), named `name`.
+BoardView ViewOfDetection(const std::string& name, const PatternDetection& detection,
+                          const std::vector<Eigen::Vector3d>& board);
 
 // Detects `pattern` in an 8-bit grey image. Throws cv::Exception only on OpenCV faults.
 PatternDetection DetectPattern(const cv::Mat& gray, const PatternSpec& pattern,

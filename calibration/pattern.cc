@@ -94,6 +94,12 @@ bool PatternSpec::Check(std::string* why) const {
   return true;
 }
 
+std::string PatternNeverFoundMessage(const PatternSpec& pattern, size_t images) {
+  return std::string("the ") + ToString(pattern.kind) + " pattern (" +
+         std::to_string(pattern.cols) + "x" + std::to_string(pattern.rows) +
+         ") was found in none of the " + std::to_string(images) + " images";
+}
+
 std::vector<Eigen::Vector3d> BoardPoints(const PatternSpec& pattern) {
   std::vector<Eigen::Vector3d> points;
   points.reserve(static_cast<size_t>(pattern.PointCount()));

@@ -35,6 +35,9 @@ struct PatternSpec {
   double MarkerSide() const { return marker > 0.0 ? marker : 0.7 * square; }
 };
 
+// "the chessboard pattern (9x6) was found in none of the N images": why a calibration has no view.
+std::string PatternNeverFoundMessage(const PatternSpec& pattern, size_t images);
+
 // The pattern's points in the board frame (metres), index i cols + j.
 std::vector<Eigen::Vector3d> BoardPoints(const PatternSpec& pattern);
 

@@ -177,7 +177,8 @@ VispCalibration CalibrateWithVisp(const std::vector<BoardView>& views, int width
         calib.addPoint(p.x(), p.y(), p.z(), ip);
       }
       vpHomogeneousMatrix cMo;
-      if (calib.computeCalibration(vpCalibration::CALIB_VIRTUAL_VS, cMo, cam, false) != 0) {
+      if (calib.computeCalibration(vpCalibration::CALIB_VIRTUAL_VS, cMo, cam, /*verbose=*/false) !=
+          0) {
         result.failure = "ViSP could not calibrate view " + view.name + " alone";
         return result;
       }
@@ -185,18 +186,18 @@ VispCalibration CalibrateWithVisp(const std::vector<BoardView>& views, int width
     }
     double error = 0.0;
     if (vpCalibration::computeCalibrationMulti(vpCalibration::CALIB_VIRTUAL_VS, calibrators, cam,
-                                               error, false) != 0) {
+                                               error, /*verbose=*/false) != 0) {
       result.failure = "ViSP calibration without distortion failed";
       return result;
     }
-    result.without = FromVisp(cam, width, height, false);
+    result.without = FromVisp(cam, width, height, /*distorted=*/false);
     result.global_error_without = error;
     if (vpCalibration::computeCalibrationMulti(vpCalibration::CALIB_VIRTUAL_VS_DIST, calibrators,
-                                               cam, error, false) != 0) {
+                                               cam, error, /*verbose=*/false) != 0) {
       result.failure = "ViSP calibration with distortion failed";
       return result;
     }
-    result.with = FromVisp(cam, width, height, true);
+    result.with = FromVisp(cam, width, height, /*distorted=*/true);
     result.global_error_with = error;
     std::vector<Eigen::Isometry3d> poses_without;
     for (const vpCalibration& c : calibrators) {

@@ -4,7 +4,7 @@
 // previous view's result), then all views together without distortion (CALIB_VIRTUAL_VS), then
 // with ViSP's one-term radial distortion (CALIB_VIRTUAL_VS_DIST; kud and kdu, models/camera.h).
 // ViSP's distorted estimate balances kud against kdu (which is not kud's exact inverse), which
-// biases it (0.2 % on px at kud = -0.22 on exact data); a final Levenberg-Marquardt refinement
+// biases it even on exact data (docs/calibration.md); a final Levenberg-Marquardt refinement
 // minimises the pixel reprojection error of the kud model alone and refits kdu as its inverse.
 #pragma once
 

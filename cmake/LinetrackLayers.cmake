@@ -8,7 +8,7 @@
 
 # Folder prefix = part, the most specific folder first.
 set(LINETRACK_PART_FOLDERS
-    "models/render/=render" "models/synth/=synth" "models/=models"
+    "models/render/=render" "models/synth/=synth" "models/import/=import" "models/=models"
     "calibration/=calibration"
     "matching/evaluation/=evaluation" "matching/heading/=heading" "matching/views/=views"
     "matching/global/=global" "matching/=matching"
@@ -23,13 +23,15 @@ set(LINETRACK_DEPS_heading heading models)
 set(LINETRACK_DEPS_views views models)
 set(LINETRACK_DEPS_global global matching heading views models)
 set(LINETRACK_DEPS_tracking tracking matching models)
+set(LINETRACK_DEPS_import import models)
 set(LINETRACK_DEPS_render render models)
 set(LINETRACK_DEPS_synth synth models)
 set(LINETRACK_DEPS_evaluation evaluation matching render synth models)
 set(LINETRACK_DEPS_sim sim tracking matching render models)
 set(LINETRACK_DEPS_fake_gige fake_gige)
 set(LINETRACK_CHECKED_PARTS
-    models calibration matching heading views global tracking render synth evaluation sim fake_gige)
+    models import calibration matching heading views global tracking render synth evaluation sim
+    fake_gige)
 
 # Sets `out` to the part of the project path `path` (e.g. "matching/lines/x.h" -> matching), or
 # to "" when the path is in none.

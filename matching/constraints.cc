@@ -116,22 +116,25 @@ Eigen::Vector3d PositionLine(const Eigen::Vector3d& n, const Eigen::Vector3d& p,
   return PositionLines(n, p, height).At(ch, sh);
 }
 
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double heading, const Eigen::Vector2d& at, double sigmas) {
-  return PositionBandHalfWidth(line, p, height, std::cos(heading), std::sin(heading), at, sigmas);
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, double heading, double sigmas) {
+  return PositionBandHalfWidth(line, p, camera,
+                               Eigen::Vector2d(std::cos(heading), std::sin(heading)), sigmas);
 }
 
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double ch, double sh, const Eigen::Vector2d& at, double sigmas) {
-  return PositionBandHalfWidth(line, p, height, ch, sh, at, sigmas,
-                               PositionLine(line.normal, p, height, ch, sh));
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, const Eigen::Vector2d& trig,
+                             double sigmas) {
+  return PositionBandHalfWidth(line, p, camera, trig, sigmas,
+                               PositionLine(line.normal, p, camera.z(), trig.x(), trig.y()));
 }
 
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double ch, double sh, const Eigen::Vector2d& at, double sigmas,
-                             const Eigen::Vector3d& l) {
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, const Eigen::Vector2d& trig,
+                             double sigmas, const Eigen::Vector3d& l) {
+  const double ch = trig.x(), sh = trig.y();
   // Rl(h) (p - C), Rl(h) with rows (sin h, -cos h, 0), (0, 0, -1), (cos h, sin h, 0).
-  const Eigen::Vector3d d = p - Eigen::Vector3d(at.x(), at.y(), height);
+  const Eigen::Vector3d d = p - camera;
   const Eigen::Vector3d w(sh * d.x() - ch * d.y(), -d.z(), ch * d.x() + sh * d.y());
   const double ab = std::sqrt(l.x() * l.x() + l.y() * l.y());
   if (ab < 1e-12) return std::numeric_limits<double>::infinity();
@@ -182,9 +185,11 @@ bool KeepNonNegative(double alpha, double beta, double* lo, double* hi) {
 
 }  // namespace
 
-bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double height, double heading,
-                    const Eigen::Vector2d& centre, double radius, double band, double slack_px,
-                    double focal_px) {
+bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, const PriorRegion& prior,
+                    double heading, double band, const Gate& gate) {
+  const double height = prior.height, radius = prior.radius;
+  const Eigen::Vector2d& centre = prior.centre;
+  const double slack_px = gate.extent_slack_px, focal_px = gate.focal_px;
   const Eigen::Vector3d p = ObservedPointOnEdge(line, edge, height, heading, centre);
   const Eigen::Vector3d l = PositionLine(line.normal, p, height, heading);
   const double ab = std::sqrt(l.x() * l.x() + l.y() * l.y());
@@ -222,9 +227,11 @@ bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double heig
   return true;
 }
 
-bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double height,
-                            const Eigen::Vector2d& centre, double radius, double slack_px,
-                            double focal_px) {
+bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge,
+                            const PriorRegion& prior, const Gate& gate) {
+  const double height = prior.height, radius = prior.radius;
+  const Eigen::Vector2d& centre = prior.centre;
+  const double slack_px = gate.extent_slack_px, focal_px = gate.focal_px;
   const double distance = (edge.foot - centre).norm();
   double lo = std::max(0.05, distance - radius), hi = distance + radius;
   if (lo > hi) return false;
@@ -245,12 +252,13 @@ bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge, dou
 }
 
 std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const MatchEdge& edge,
-                                              double height, const HeadingInterval& prior,
-                                              const Eigen::Vector2d& centre, double radius,
-                                              const Gate& gate) {
+                                              const PriorRegion& prior, const Gate& gate) {
   const double sigmas = gate.sigmas;
+  const double height = prior.height, radius = prior.radius;
+  const Eigen::Vector2d& centre = prior.centre;
+  const Eigen::Vector3d camera(centre.x(), centre.y(), height);
   std::vector<HeadingInterval> out;
-  for (const HeadingInterval& j : DirectionIntervals(line, edge.dir, prior, sigmas)) {
+  for (const HeadingInterval& j : DirectionIntervals(line, edge.dir, prior.heading, sigmas)) {
     // Signed distance of the disk centre to the position line at headings across the interval:
     // a sign change means a crossing; else the smallest distance must be within the disk radius
     // plus the noise band.
@@ -270,7 +278,7 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
       crosses = crosses || (sign != 0 && sg != sign);
       sign = sg;
       smallest = std::min(smallest, std::abs(s));
-      band = std::max(band, PositionBandHalfWidth(line, p, height, h, centre, sigmas));
+      band = std::max(band, PositionBandHalfWidth(line, p, camera, h, sigmas));
     }
     // The extent is checked at the exact root of the direction constraint when the interval
     // holds one (the interval may be clipped by the prior, so its middle can be off), and at
@@ -282,8 +290,7 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
     }
     bool extent = false;
     for (double h : {h_root, j.lo, j.hi}) {
-      extent = extent || ExtentFeasible(line, edge, height, h, centre, radius, band,
-                                        gate.extent_slack_px, gate.focal_px);
+      extent = extent || ExtentFeasible(line, edge, prior, h, band, gate);
     }
     if ((crosses || smallest <= radius + band) && extent) {
       out.push_back(j);
@@ -293,24 +300,21 @@ std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const Ma
 }
 
 std::optional<HeadingInterval> UnaryVertical(const ObservedLine& line, const MatchEdge& edge,
-                                             double height, const HeadingInterval& prior,
-                                             const Eigen::Vector2d& centre, double radius,
-                                             const Gate& gate) {
+                                             const PriorRegion& prior, const Gate& gate) {
   const double sigmas = gate.sigmas;
-  if (!VerticalExtentFeasible(line, edge, height, centre, radius, gate.extent_slack_px,
-                              gate.focal_px)) {
-    return std::nullopt;
-  }
+  const double radius = prior.radius;
+  const Eigen::Vector2d& centre = prior.centre;
+  if (!VerticalExtentFeasible(line, edge, prior, gate)) return std::nullopt;
   const Eigen::Vector2d to_centre = centre - edge.foot;
   const double distance = to_centre.norm();
-  if (distance <= radius) return prior;
+  if (distance <= radius) return prior.heading;
   const double gamma = std::atan2(to_centre.y(), to_centre.x());
   const double spread = std::asin(radius / distance) + sigmas * line.bearing_sigma;
   // Camera direction from the foot is (h - w) + pi; it must lie within gamma +- spread.
   const double h_mid = gamma - kPi + line.bearing;
   HeadingInterval parts[3];
   int count = 0;
-  IntersectModulo({h_mid - spread, h_mid + spread}, prior, parts, &count);
+  IntersectModulo({h_mid - spread, h_mid + spread}, prior.heading, parts, &count);
   if (count == 0) return std::nullopt;
   MergeInPlace(parts, count);
   return parts[0];

@@ -26,6 +26,19 @@ struct HeadingInterval {
   double Width() const { return hi - lo; }
 };
 
+// The prior the constraints test against: the disk of camera positions (centre, radius, metres)
+// and the interval of headings, at the known camera height (metres).
+struct PriorRegion {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius = 0.0;
+  HeadingInterval heading;
+  double height = 0.0;
+  double focal_px = 1000.0;  // mean focal length of the camera (pixels)
+  // When set, camera positions lie in this box (the navigable area's bounds).
+  bool has_bounds = false;
+  Eigen::Vector2d bounds_min = Eigen::Vector2d::Zero(), bounds_max = Eigen::Vector2d::Zero();
+};
+
 // Margins of the constraints: the noise gate in standard deviations, and the tolerance of the
 // extent constraints at segment endpoints (pixels, for a camera of focal length focal_px).
 struct Gate {
@@ -94,17 +107,18 @@ class PositionLines {
   double c_, s_, z_;
 };
 
-// Half-width (metres) of the noise band around the position line at camera position `at`:
-// sigmas * std(g2) / |(A, B)|.
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double heading, const Eigen::Vector2d& at, double sigmas);
-// The same with cos h, sin h given (hot loops).
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas);
-// The same with PositionLine(line.normal, p, height, cos_h, sin_h) given as `position_line`.
-double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p, double height,
-                             double cos_h, double sin_h, const Eigen::Vector2d& at, double sigmas,
-                             const Eigen::Vector3d& position_line);
+// Half-width (metres) of the noise band around the position line through the edge point p at
+// heading h, for the camera centre `camera` (x, y, height): sigmas * std(g2) / |(A, B)|.
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, double heading, double sigmas);
+// The same with trig = (cos h, sin h) given (hot loops).
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, const Eigen::Vector2d& trig,
+                             double sigmas);
+// The same with PositionLine(line.normal, p, camera.z(), cos h, sin h) given as `position_line`.
+double PositionBandHalfWidth(const ObservedLine& line, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& camera, const Eigen::Vector2d& trig,
+                             double sigmas, const Eigen::Vector3d& position_line);
 
 // The point of the edge (clamped to it) seen along the segment's middle ray from camera
 // position `at` at heading h: the closest point of the edge's line to that viewing ray. The
@@ -121,34 +135,30 @@ double DistanceToLine(const Eigen::Vector3d& line, const Eigen::Vector2d& point)
 // (occlusion only shortens it), in front of the camera. At heading h the camera lies on the
 // position line; along it (C(s) = C0 + s u) the edge parameter mu_k(s) where endpoint ray k meets
 // the edge line, and the ray depth lambda_k(s), are linear in s. True when some s on the chord
-// of the disk (widened by `band` metres) has 0 < lambda_k and mu_k within the edge, with
-// `slack_px` pixels of tolerance at the endpoints.
-bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double height, double heading,
-                    const Eigen::Vector2d& centre, double radius, double band, double slack_px,
-                    double focal_px);
+// of the prior's disk (widened by `band` metres) has 0 < lambda_k and mu_k within the edge, with
+// the gate's extent_slack_px pixels of tolerance at the endpoints.
+bool ExtentFeasible(const ObservedLine& line, const MatchEdge& edge, const PriorRegion& prior,
+                    double heading, double band, const Gate& gate);
 
 // Extent constraint for a vertical edge: the heights where the endpoint rays meet the edge,
-// z_cam + D tan(elevation_k), must lie within the edge's z range (with `slack_px` of tolerance)
-// for some horizontal distance D from the disk to the foot. Independent of the heading.
-bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge, double height,
-                            const Eigen::Vector2d& centre, double radius, double slack_px,
-                            double focal_px);
+// z_cam + D tan(elevation_k), must lie within the edge's z range (with the gate's
+// extent_slack_px of tolerance) for some horizontal distance D from the prior's disk to the foot.
+// Independent of the heading.
+bool VerticalExtentFeasible(const ObservedLine& line, const MatchEdge& edge,
+                            const PriorRegion& prior, const Gate& gate);
 
 // Unary constraint for a non-vertical edge (paper, fig. 4, with noise margins): some heading in
-// `prior` satisfies the direction constraint and its position line passes within the band of
-// the disk (centre, radius). Returns the admissible heading intervals (empty: rejected).
+// the prior's interval satisfies the direction constraint and its position line passes within
+// the band of the prior's disk. Returns the admissible heading intervals (empty: rejected).
 std::vector<HeadingInterval> UnaryNonVertical(const ObservedLine& line, const MatchEdge& edge,
-                                              double height, const HeadingInterval& prior,
-                                              const Eigen::Vector2d& centre, double radius,
-                                              const Gate& gate);
+                                              const PriorRegion& prior, const Gate& gate);
 
 // Unary constraint for a vertical edge (not in the paper): the camera lies on the ray from the
-// edge's foot opposite to the world bearing h - w; for h in `prior` these rays sweep a wedge that
-// must meet the disk; and the vertical extent must fit. Returns the admissible heading interval.
+// edge's foot opposite to the world bearing h - w; for h in the prior's interval these rays sweep
+// a wedge that must meet the prior's disk; and the vertical extent must fit. Returns the
+// admissible heading interval.
 std::optional<HeadingInterval> UnaryVertical(const ObservedLine& line, const MatchEdge& edge,
-                                             double height, const HeadingInterval& prior,
-                                             const Eigen::Vector2d& centre, double radius,
-                                             const Gate& gate);
+                                             const PriorRegion& prior, const Gate& gate);
 
 // Range [lo, hi] (radians) of the signed angle from the direction camera -> foot2 to the
 // direction camera -> foot1, over camera positions in the disk: the inscribed angle is harmonic in

@@ -1,10 +1,7 @@
-// The model edges' images at a pose and the image lines within their gates: the projection
-// (with its derivatives w.r.t. heading, x, y and focal scale) and the candidate pairs that guided
-// matching, the rival explanations and the doubt of unreported pairs start from.
+#include "matching/edge_candidates.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "matching/verification_internal.h"
 
 namespace linetrack {
 namespace {
@@ -65,7 +62,6 @@ RobotPose Full(const Pose3Dof& pose, const VerificationContext& context) {
   return {pose.x, pose.y, pose.heading, context.height, context.tilt};
 }
 
-// The camera with its focal lengths scaled by `scale` (the estimated calibration error).
 CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
   CameraIntrinsics c = camera;
   c.px *= scale;
@@ -73,8 +69,6 @@ CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
   return c;
 }
 
-// The edges' images at `pose` over the stretches of them inside the frustum of `seen` (which
-// decides visibility and extent; `pose` the position of the image lines).
 std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
                                             const Pose3Dof& pose, double focal_scale,
                                             const Pose3Dof& seen, double seen_scale) {
@@ -115,24 +109,20 @@ std::vector<EdgeImage> ProjectPairedEdges(const VerificationContext& context, co
   return out;
 }
 
-// Every (line, edge) pair within the gates at `pose` (covariance `pose_covariance` of heading,
-// x, y, scale), the edge not hidden where the line lies (seen from `seen` when given, of focal
-// scale `seen_scale`), and likelier than clutter (any finite ratio when `any_ratio`).
 std::vector<Candidate> Candidates(const VerificationContext& context,
-                                  const std::vector<EdgeImage>& images, const Pose3Dof& pose,
-                                  double focal_scale, const Eigen::Matrix4d& pose_covariance,
-                                  const LineFitModel& model, bool any_ratio, const Pose3Dof* seen,
-                                  double seen_scale) {
-  const Pose3Dof& viewpoint = seen != nullptr ? *seen : pose;
-  const CameraIntrinsics camera =
-      ScaledCamera(*context.camera, seen != nullptr ? seen_scale : focal_scale);
-  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(viewpoint, context));
-  const Eigen::Vector3d eye(viewpoint.x, viewpoint.y, context.height);
+                                  const std::vector<EdgeImage>& images, const LineFitModel& model,
+                                  const CandidateQuery& query, VerificationStats* stats) {
+  const Eigen::Matrix4d& pose_covariance = query.covariance;
+  const bool any_ratio = query.any_ratio;
+  const PoseAndScale& viewpoint = query.seen ? *query.seen : query.at;
+  const CameraIntrinsics camera = ScaledCamera(*context.camera, viewpoint.focal_scale);
+  const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(viewpoint.pose, context));
+  const Eigen::Vector3d eye(viewpoint.pose.x, viewpoint.pose.y, context.height);
   std::vector<Candidate> out;
-  if (context.pair_tests != nullptr) {
+  if (stats != nullptr) {
     const long visible = std::count_if(images.begin(), images.end(),
                                        [](const EdgeImage& image) { return image.visible; });
-    *context.pair_tests += visible * static_cast<long>(context.lines->size());
+    stats->pair_tests += visible * static_cast<long>(context.lines->size());
   }
   // Per edge: the ends' variances along the projection, and a distance beyond which no line
   // can be within the gate: chi2 >= max(r_a^2, r_b^2) / trace(covariance), with the trace at most

@@ -32,17 +32,30 @@ HeadingBin& Append(const HeadingBin& bin, FeasibleRegion* out) {
   return b;
 }
 
-// side_k[i] = n_k . v[i] + d_k for the m vertices and both half-planes; inside_k counts the
-// vertices on the kept side (side_k >= 0).
-void BothSides(const Eigen::Vector2d* v, int m, const Eigen::Vector2d& n1, double d1,
-               const Eigen::Vector2d& n2, double d2, double* side1, double* side2, int* inside1,
-               int* inside2) {
+// The half-plane n . v + d >= 0.
+struct HalfPlane {
+  const Eigen::Vector2d& n;
+  double d = 0.0;
+};
+
+// How many vertices lie on the kept side of each of two half-planes.
+struct InsideCounts {
+  int first = 0;
+  int second = 0;
+};
+
+// side_k[i] = n_k . v[i] + d_k for the m vertices v and both half-planes h_k; returns how many
+// vertices are on the kept side (side_k >= 0) of each.
+InsideCounts BothSides(const Eigen::Vector2d* v, int m, const HalfPlane& h1, const HalfPlane& h2,
+                       double* side1, double* side2) {
+  InsideCounts inside;
   for (int i = 0; i < m; ++i) {
-    side1[i] = n1.dot(v[i]) + d1;
-    side2[i] = n2.dot(v[i]) + d2;
-    *inside1 += side1[i] >= 0.0 ? 1 : 0;
-    *inside2 += side2[i] >= 0.0 ? 1 : 0;
+    side1[i] = h1.n.dot(v[i]) + h1.d;
+    side2[i] = h2.n.dot(v[i]) + h2.d;
+    inside.first += side1[i] >= 0.0 ? 1 : 0;
+    inside.second += side2[i] >= 0.0 ? 1 : 0;
   }
+  return inside;
 }
 
 bool Overlaps(const HeadingBin& bin, const HeadingInterval* parts, int count) {
@@ -123,9 +136,9 @@ void ConvexPolygon::ClipFrom(const ConvexPolygon& source, const Eigen::Vector2d&
     return;
   }
   std::array<double, kMaxVertices> side1, side2;
-  int inside1 = 0, inside2 = 0;
-  BothSides(source.begin(), source.count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1,
-            &inside2);
+  const InsideCounts inside =
+      BothSides(source.begin(), source.count_, {n1, d1}, {n2, d2}, side1.data(), side2.data());
+  const int inside1 = inside.first, inside2 = inside.second;
   const bool all1 = inside1 == source.count_, all2 = inside2 == source.count_;
   if (inside1 == 0 || inside2 == 0) {
     Clear();
@@ -164,10 +177,10 @@ bool ConvexPolygon::MeetsBoth(const Eigen::Vector2d& n1, double d1, const Eigen:
                               double d2) const {
   if (count_ == 0 || MaxSideBound(n1, d1) < 0.0 || MaxSideBound(n2, d2) < 0.0) return false;
   std::array<double, kMaxVertices> side1, side2;
-  int inside1 = 0, inside2 = 0;
-  BothSides(begin(), count_, n1, d1, n2, d2, side1.data(), side2.data(), &inside1, &inside2);
-  const bool all1 = inside1 == count_, all2 = inside2 == count_;
-  if (inside1 == 0 || inside2 == 0) return false;
+  const InsideCounts inside =
+      BothSides(begin(), count_, {n1, d1}, {n2, d2}, side1.data(), side2.data());
+  const bool all1 = inside.first == count_, all2 = inside.second == count_;
+  if (inside.first == 0 || inside.second == 0) return false;
   if (all1 && all2) return !Empty();
   if (all1) return ClippedCount(count_, side2.data()) >= 3;
   if (all2) return ClippedCount(count_, side1.data()) >= 3;
@@ -301,8 +314,8 @@ Band NonVerticalBand(const ObservedLine& line, const MatchEdge& edge, double hei
         std::max({slack, std::abs(SignedDistance(lo, q) - s), std::abs(SignedDistance(hi, q) - s)});
   }
   return {Eigen::Vector2d(mid.x(), mid.y()), mid.z(),
-          PositionBandHalfWidth(line, p, height, bin.trig_mid.x(), bin.trig_mid.y(), centre, sigmas,
-                                mid_line) +
+          PositionBandHalfWidth(line, p, Eigen::Vector3d(centre.x(), centre.y(), height),
+                                bin.trig_mid, sigmas, mid_line) +
               slack,
           lo_s, hi_s};
 }

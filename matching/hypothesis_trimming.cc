@@ -1,42 +1,31 @@
 // Cleaning a hypothesis before it is verified: the consensus restart, the trimming of residual
-// outliers, the per-pair outlier test, the leave-one-out rivals of the decision and
-// the refinement over the pairs an answer vouches for.
+// outliers and the per-pair outlier test.
+#include "matching/hypothesis_trimming.h"
+
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <optional>
 
-#include <Eigen/Eigenvalues>
-
-#include "matching/verification.h"
-#include "matching/verification_internal.h"
+#include "matching/quantiles.h"
 
 namespace linetrack {
 
-PoseRefinementOptions RefinementOptions(const VerificationContext& context,
-                                        const VerificationOptions& options) {
-  PoseRefinementOptions refinement = options.refinement;
-  if (context.prior == nullptr) return refinement;
-  const PriorRegion& prior = *context.prior;
-  refinement.bounds.active = true;
-  refinement.bounds.centre = prior.centre;
-  refinement.bounds.radius_m = prior.radius + options.prior_margin_m;
-  refinement.bounds.heading = prior.heading.Mid();
-  refinement.bounds.half_width_rad =
-      0.5 * prior.heading.Width() + DegToRad(options.prior_margin_deg);
-  refinement.bounds.sigmas = options.prior_margin_sigmas;
-  return refinement;
+bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOptions& options) {
+  const int dof = 2 * static_cast<int>(hypothesis.pairs.size()) - 3;
+  return hypothesis.refinement.chi2 <=
+         ChiSquareQuantile(dof, NormalQuantile(options.hypothesis_quantile));
 }
 
 namespace {
 
 // The largest subset of the hypothesis' pairs that agrees with one minimal pose (two of its
 // pairs, at least one non-vertical): each pair's whitened residuals there within
-// consensus_chi2. Returns the pairs and sets *pose; empty when no minimal pose exists.
+// consensus_chi2. Returns the pairs and sets *pose; empty when no minimal pose exists. Reads and
+// fills `memo` when given.
 std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
                                            const VerificationOptions& options,
                                            const std::vector<std::pair<int, int>>& pairs,
-                                           Pose3Dof* pose) {
+                                           Pose3Dof* pose, ConsensusMemo* memo) {
   const std::vector<LineMatch> matches = ToLineMatches(context, pairs);
   std::vector<std::pair<int, int>> best;
   double best_chi2 = 0.0;
@@ -48,8 +37,8 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
       const auto [e2, l2] = pairs[j];
       ConsensusMemo::Entry* entry = &local;
       bool fresh = true;
-      if (context.consensus_memo != nullptr) {
-        const auto [it, inserted] = context.consensus_memo->entries.try_emplace(
+      if (memo != nullptr) {
+        const auto [it, inserted] = memo->entries.try_emplace(
             {ConsensusMemo::PairKey(pairs[i]), ConsensusMemo::PairKey(pairs[j])});
         entry = &it->second;
         fresh = inserted;
@@ -97,38 +86,39 @@ std::vector<std::pair<int, int>> Consensus(const VerificationContext& context,
 
 namespace {
 
-// Levenberg-Marquardt on `pairs` from (start, scale); read from and added to the context's memo
-// when it has one (the trimming of sibling leaves refits the same pairs from the same starts).
+// Levenberg-Marquardt on `pairs` from `start`; read from and added to `memo` when given (the
+// trimming of sibling leaves refits the same pairs from the same starts).
 PoseRefinementResult Refit(const VerificationContext& context, const VerificationOptions& options,
-                           const std::vector<std::pair<int, int>>& pairs, const Pose3Dof& start,
-                           double scale) {
+                           const std::vector<std::pair<int, int>>& pairs, const PoseAndScale& start,
+                           ConsensusMemo* memo) {
   auto refine = [&] {
     return RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                      start, scale, RefinementOptions(context, options));
+                      start, RefinementOptions(context, options));
   };
-  if (context.consensus_memo == nullptr) return refine();
-  ConsensusMemo::RefitKey key{pairs, {start.x, start.y, start.heading, scale}};
-  const auto found = context.consensus_memo->refits.find(key);
-  if (found != context.consensus_memo->refits.end()) return found->second;
+  if (memo == nullptr) return refine();
+  ConsensusMemo::RefitKey key{pairs,
+                              {start.pose.x, start.pose.y, start.pose.heading, start.focal_scale}};
+  const auto found = memo->refits.find(key);
+  if (found != memo->refits.end()) return found->second;
   const PoseRefinementResult result = refine();
-  context.consensus_memo->refits.emplace(std::move(key), result);
+  memo->refits.emplace(std::move(key), result);
   return result;
 }
 
 // The chi-square test of a hypothesis as a whole, restored by the consensus restart and the
 // trimming of the largest residual (TrimHypothesis without the per-pair test).
 bool RestoreConsistency(const VerificationContext& context, const VerificationOptions& options,
-                        VerifiedPose* hypothesis) {
+                        VerifiedPose* hypothesis, ConsensusMemo* memo) {
   if (ConsistentHypothesis(*hypothesis, options)) return true;
   const std::vector<std::pair<int, int>> original = hypothesis->pairs;
   {
     // A leaf holding wrong pairs: restart from the pairs that agree with a minimal pose.
     Pose3Dof start;
     std::vector<std::pair<int, int>> agreeing =
-        Consensus(context, options, hypothesis->pairs, &start);
+        Consensus(context, options, hypothesis->pairs, &start, memo);
     if (agreeing.size() < 3) return false;
     hypothesis->pairs = std::move(agreeing);
-    hypothesis->refinement = Refit(context, options, hypothesis->pairs, start, 1.0);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs, {start, 1.0}, memo);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   while (!ConsistentHypothesis(*hypothesis, options)) {
@@ -138,9 +128,9 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
     double worst_chi2 = -1.0;
     for (size_t i = 0; i < matches.size(); ++i) {
       const double chi2 =
-          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                    context.tilt, hypothesis->pose,
-                                                    hypothesis->refinement.focal_scale, nullptr))
+          (matches[i].whitening *
+           EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                             {hypothesis->pose, hypothesis->refinement.focal_scale}, nullptr))
               .squaredNorm();
       if (chi2 > worst_chi2) {
         worst_chi2 = chi2;
@@ -148,8 +138,8 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
       }
     }
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
-                                   hypothesis->refinement.focal_scale);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs,
+                                   {hypothesis->pose, hypothesis->refinement.focal_scale}, memo);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   // Pairs dropped on the way that fit the consistent pose are taken back (the minimal pose of the
@@ -162,15 +152,15 @@ bool RestoreConsistency(const VerificationContext& context, const VerificationOp
         continue;
       }
       const double chi2 =
-          (matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                    context.tilt, hypothesis->pose,
-                                                    hypothesis->refinement.focal_scale, nullptr))
+          (matches[i].whitening *
+           EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                             {hypothesis->pose, hypothesis->refinement.focal_scale}, nullptr))
               .squaredNorm();
       if (chi2 <= options.gate_chi2) trial.pairs.push_back(original[i]);
     }
     if (trial.pairs.size() == hypothesis->pairs.size()) break;
-    trial.refinement =
-        Refit(context, options, trial.pairs, hypothesis->pose, hypothesis->refinement.focal_scale);
+    trial.refinement = Refit(context, options, trial.pairs,
+                             {hypothesis->pose, hypothesis->refinement.focal_scale}, memo);
     trial.pose = trial.refinement.pose;
     if (!ConsistentHypothesis(trial, options)) break;
     *hypothesis = std::move(trial);
@@ -190,9 +180,9 @@ int OutlyingPair(const VerificationContext& context, const VerificationOptions& 
   for (size_t i = 0; i < matches.size(); ++i) {
     Eigen::Matrix<double, 2, 4> j;
     const Eigen::Vector2d r =
-        matches[i].whitening * EndpointResiduals(matches[i], *context.camera, context.height,
-                                                 context.tilt, hypothesis.pose,
-                                                 hypothesis.refinement.focal_scale, &j);
+        matches[i].whitening *
+        EndpointResiduals(matches[i], *context.camera, context.height, context.tilt,
+                          {hypothesis.pose, hypothesis.refinement.focal_scale}, &j);
     const Eigen::Matrix<double, 2, 4> wj = matches[i].whitening * j;
     const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
     // A leverage near 1 (the pair alone fixes a direction of the pose) cannot be tested.
@@ -213,7 +203,7 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
   Eigen::Matrix<double, 2, 4> j;
   const Eigen::Vector2d r =
       match.whitening * EndpointResiduals(match, *context.camera, context.height, context.tilt,
-                                          verified.pose, verified.refinement.focal_scale, &j);
+                                          {verified.pose, verified.refinement.focal_scale}, &j);
   const Eigen::Matrix<double, 2, 4> wj = match.whitening * j;
   const Eigen::Matrix4d& c = verified.refinement.bounded_covariance;
   const Eigen::Matrix2d complement = Eigen::Matrix2d::Identity() - wj * c * wj.transpose();
@@ -230,81 +220,17 @@ bool DeletedPose(const VerificationContext& context, const VerifiedPose& verifie
   return true;
 }
 
-PoseRefinementResult VouchedRefinement(const VerificationContext& context,
-                                       const VerificationOptions& options,
-                                       const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported,
-                                       std::vector<std::pair<int, int>>* kept_pairs) {
-  const std::vector<LineMatch> matches = ToLineMatches(context, verified.pairs);
-  const Eigen::Matrix4d& c = verified.refinement.covariance;
-  std::vector<LineMatch> kept;
-  if (kept_pairs != nullptr) kept_pairs->clear();
-  for (size_t i = 0; i < matches.size(); ++i) {
-    if (std::find(reported.begin(), reported.end(), verified.pairs[i]) != reported.end()) {
-      kept.push_back(matches[i]);
-      if (kept_pairs != nullptr) kept_pairs->push_back(verified.pairs[i]);
-      continue;
-    }
-    Eigen::Matrix<double, 2, 4> j;
-    EndpointResiduals(matches[i], *context.camera, context.height, context.tilt, verified.pose,
-                      verified.refinement.focal_scale, &j);
-    const Eigen::Matrix<double, 2, 4> wj = matches[i].whitening * j;
-    const Eigen::Matrix2d leverage = wj * c * wj.transpose();
-    // The variance along the worst direction grows by 1 / (1 - largest eigenvalue) without it.
-    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(leverage, Eigen::EigenvaluesOnly)
-            .eigenvalues()
-            .maxCoeff() < options.max_unreported_leverage) {
-      kept.push_back(matches[i]);
-      if (kept_pairs != nullptr) kept_pairs->push_back(verified.pairs[i]);
-    }
-  }
-  if (kept.size() == matches.size()) return verified.refinement;
-  // Refitted under the same cost as the verification (the prior's bounds included), so the kept
-  // pairs cannot slide out of the prior; the result's covariance is the image information alone.
-  return RefinePose(kept, *context.camera, context.height, context.tilt, verified.pose,
-                    verified.refinement.focal_scale, RefinementOptions(context, options));
-}
-
-std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
-                                            const VerificationOptions& options,
-                                            const VerifiedPose& verified) {
-  std::vector<VerifiedPose> rivals;
-  // A pair is influential when the pose without it moves beyond the pose's own uncertainty
-  // (Cook's distance: Mahalanobis shift against the chi-square quantile, 3 dof).
-  const Eigen::Matrix3d c = verified.refinement.covariance.topLeftCorner<3, 3>();
-  const double influential = ChiSquareQuantile(3.0, NormalQuantile(options.hypothesis_quantile));
-  for (size_t i = 0; i < verified.pairs.size(); ++i) {
-    Pose3Dof moved;
-    // A pair that alone fixes a direction of the pose (no deleted pose) is always tried.
-    if (DeletedPose(context, verified, i, &moved) && c.determinant() > 0.0) {
-      const Eigen::Vector3d shift(WrapAngle(moved.heading - verified.pose.heading),
-                                  moved.x - verified.pose.x, moved.y - verified.pose.y);
-      if (SamePose(moved, verified.pose, options) &&
-          shift.dot(c.ldlt().solve(shift)) <= influential) {
-        continue;
-      }
-    }
-    std::vector<std::pair<int, int>> others = verified.pairs;
-    others.erase(others.begin() + static_cast<long>(i));
-    VerificationContext without = context;
-    without.excluded_pair = verified.pairs[i];
-    rivals.push_back(
-        Rematch(without, RefineHypothesis(context, others, {moved}, options), options));
-  }
-  return rivals;
-}
-
 bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
-                    VerifiedPose* hypothesis) {
-  if (!RestoreConsistency(context, options, hypothesis)) return false;
+                    VerifiedPose* hypothesis, ConsensusMemo* memo) {
+  if (!RestoreConsistency(context, options, hypothesis, memo)) return false;
   // A wrong pair can hide in a consistent hypothesis by moving the pose along a weakly observed
   // direction: each pair is tested against the pose of the others.
   for (int worst = OutlyingPair(context, options, *hypothesis); worst >= 0;
        worst = OutlyingPair(context, options, *hypothesis)) {
     if (hypothesis->pairs.size() <= 3) return false;
     hypothesis->pairs.erase(hypothesis->pairs.begin() + worst);
-    hypothesis->refinement = Refit(context, options, hypothesis->pairs, hypothesis->pose,
-                                   hypothesis->refinement.focal_scale);
+    hypothesis->refinement = Refit(context, options, hypothesis->pairs,
+                                   {hypothesis->pose, hypothesis->refinement.focal_scale}, memo);
     hypothesis->pose = hypothesis->refinement.pose;
   }
   return true;

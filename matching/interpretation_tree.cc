@@ -11,10 +11,10 @@
 namespace linetrack {
 
 bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
-                          const std::vector<std::pair<int, int>>& fitting) {
+                          const std::vector<std::pair<int, int>>& consensus) {
   return std::any_of(pairs.begin(), pairs.end(), [&](const std::pair<int, int>& p) {
-    if (std::binary_search(fitting.begin(), fitting.end(), p)) return false;
-    return std::any_of(fitting.begin(), fitting.end(),
+    if (std::binary_search(consensus.begin(), consensus.end(), p)) return false;
+    return std::any_of(consensus.begin(), consensus.end(),
                        [&](const std::pair<int, int>& f) { return f.second == p.second; });
   });
 }
@@ -27,21 +27,22 @@ namespace {
 // line left unexplained removes its cap from the bound at once.
 class TreeSearch {
  public:
-  TreeSearch(const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
-             const PriorRegion& prior, const InterpretationTreeOptions& options,
-             const std::vector<double>& line_caps, const LeafVisitor& visit,
-             InterpretationTreeStats* stats, const std::vector<VerifiedBasin>* basins)
-      : edges_(edges),
-        lines_(lines),
-        prior_(prior),
+  TreeSearch(const TreeProblem& problem, const InterpretationTreeOptions& options,
+             const LeafVisitor& visit, InterpretationTreeStats* stats,
+             const std::vector<VerifiedNeighbourhood>* neighbourhoods)
+      : edges_(*problem.edges),
+        lines_(*problem.lines),
+        prior_(*problem.prior),
         options_(options),
         visit_(visit),
         stats_(stats),
-        basins_(basins) {
+        neighbourhoods_(neighbourhoods) {
     gate_.sigmas = options.gate_sigmas;
     gate_.extent_slack_px = options.extent_slack_px;
-    gate_.focal_px = prior.focal_px;
-    caps_ = line_caps.empty() ? std::vector<double>(lines.size(), 1.0) : line_caps;
+    gate_.focal_px = prior_.focal_px;
+    caps_ = problem.line_caps == nullptr || problem.line_caps->empty()
+                ? std::vector<double>(lines_.size(), 1.0)
+                : *problem.line_caps;
   }
 
   // Builds the candidates and the root region; false when there is nothing to search.
@@ -112,9 +113,9 @@ class TreeSearch {
     ++stats_->passes;
     const double share = 1.0 / static_cast<double>(branches.edges.size());
     for (const int edge : branches.edges) {
-      node_cap_ = stats_->nodes + std::max(1, static_cast<int>(share * options_.max_nodes));
-      leaf_cap_ = stats_->leaves + std::max(1, static_cast<int>(share * options_.max_hypotheses));
-      check_cap_ = stats_->checks + std::max(1, static_cast<int>(share * options_.max_checks));
+      node_limit_ = stats_->nodes + std::max(1, static_cast<int>(share * options_.max_nodes));
+      leaf_limit_ = stats_->leaves + std::max(1, static_cast<int>(share * options_.max_hypotheses));
+      check_limit_ = stats_->checks + std::max(1, static_cast<int>(share * options_.max_checks));
       if (edge < 0) {
         decided_[line] = kClutter;
         alive_[1] = alive_[0];
@@ -138,8 +139,7 @@ class TreeSearch {
 
   // Unary constraints: each line against the non-vertical edges and, when it can be the image of
   // a vertical edge, against the vertical ones. Lines are searched by decreasing cap: leaving
-  // those unexplained lowers the bound most, so wrong branches are cut soonest (measured better
-  // than longest first on the benchmark: 98.4 against 97.9 % correct at QI2).
+  // those unexplained lowers the bound most, so wrong branches are cut soonest.
   void BuildCandidates() {
     order_.resize(lines_.size());
     std::iota(order_.begin(), order_.end(), 0);
@@ -156,13 +156,9 @@ class TreeSearch {
         bool pass = false;
         if (edges_[e].vertical) {
           pass = lines_[j].maybe_vertical &&
-                 UnaryVertical(lines_[j], edges_[e], prior_.height, prior_.heading, prior_.centre,
-                               prior_.radius, gate_)
-                     .has_value();
+                 UnaryVertical(lines_[j], edges_[e], prior_, gate_).has_value();
         } else {
-          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_.height, prior_.heading,
-                                   prior_.centre, prior_.radius, gate_)
-                      .empty();
+          pass = !UnaryNonVertical(lines_[j], edges_[e], prior_, gate_).empty();
         }
         if (!pass) continue;
         candidate_edge_.push_back(static_cast<int>(e));
@@ -226,13 +222,13 @@ class TreeSearch {
     assigned_.emplace_back(edge, line);
     assigned_caps_ += caps_[line];
     distinct_edges_ += edge_lines_[edge]++ == 0 ? 1 : 0;
-    for (size_t b = 0; b < basin_fit_.size(); ++b)
-      basin_fit_[b] += basin_flags_[b][c];
+    for (size_t b = 0; b < consensus_fit_.size(); ++b)
+      consensus_fit_[b] += consensus_flags_[b][c];
   }
   void Unassign(int c, int line) {
     const int edge = candidate_edge_[c];
-    for (size_t b = 0; b < basin_fit_.size(); ++b)
-      basin_fit_[b] -= basin_flags_[b][c];
+    for (size_t b = 0; b < consensus_fit_.size(); ++b)
+      consensus_fit_[b] -= consensus_flags_[b][c];
     distinct_edges_ -= --edge_lines_[edge] == 0 ? 1 : 0;
     assigned_caps_ -= caps_[line];
     assigned_.pop_back();
@@ -256,7 +252,8 @@ class TreeSearch {
   // with a candidate still alive; lines without one are clutter for free (their cap is no longer
   // in the bound).
   void Search(size_t depth, const FeasibleRegion& region) {
-    if (stats_->nodes >= node_cap_ || stats_->leaves >= leaf_cap_ || stats_->checks >= check_cap_) {
+    if (stats_->nodes >= node_limit_ || stats_->leaves >= leaf_limit_ ||
+        stats_->checks >= check_limit_) {
       stats_->budget_exhausted = true;
       return;
     }
@@ -275,8 +272,8 @@ class TreeSearch {
       if (next < 0) next = j;
     }
     if (distinct_edges_ + open_lines < options_.min_matches ||
-        assigned_caps_ + reachable < Bound() || InBasin(region, assigned_caps_ + reachable) ||
-        VerifiedAgain(open_lines)) {
+        assigned_caps_ + reachable < Bound() ||
+        InNeighbourhood(region, assigned_caps_ + reachable) || VerifiedAgain(open_lines)) {
       return;
     }
     if (next < 0) {
@@ -346,36 +343,38 @@ class TreeSearch {
 
   // True when every leaf below would have most of its pairs fitting a verified pose and fewer
   // lines than it explains (the visitor skips those: they would be verified into it again).
-  // Basins the visitor added since the last node are indexed here first.
+  // Neighbourhoods the visitor added since the last node are indexed here first.
   bool VerifiedAgain(int open_lines) {
-    if (basins_ == nullptr) return false;
-    while (basin_flags_.size() < basins_->size()) {
-      const VerifiedBasin& basin = (*basins_)[basin_flags_.size()];
+    if (neighbourhoods_ == nullptr) return false;
+    while (consensus_flags_.size() < neighbourhoods_->size()) {
+      const VerifiedNeighbourhood& neighbourhood = (*neighbourhoods_)[consensus_flags_.size()];
       std::vector<char> flags(candidate_edge_.size(), 0);
       for (size_t c = 0; c < flags.size(); ++c) {
-        flags[c] = std::binary_search(basin.fitting.begin(), basin.fitting.end(),
-                                      std::make_pair(candidate_edge_[c], candidate_line_[c]));
+        flags[c] =
+            std::binary_search(neighbourhood.consensus.begin(), neighbourhood.consensus.end(),
+                               std::make_pair(candidate_edge_[c], candidate_line_[c]));
       }
       int fit = 0;
       for (const auto& [e, l] : assigned_)
         fit += flags[decided_[l]];
-      basin_flags_.push_back(std::move(flags));
-      basin_fit_.push_back(fit);
+      consensus_flags_.push_back(std::move(flags));
+      consensus_fit_.push_back(fit);
     }
     const int most = static_cast<int>(assigned_.size()) + open_lines;
-    for (size_t b = 0; b < basin_fit_.size(); ++b) {
-      if (most < (*basins_)[b].lines && 2 * basin_fit_[b] > most) return true;
+    for (size_t b = 0; b < consensus_fit_.size(); ++b) {
+      if (most < (*neighbourhoods_)[b].lines && 2 * consensus_fit_[b] > most) return true;
     }
     return false;
   }
 
-  // True when the region lies in the basin of a verified pose and its leaves cannot reach that
-  // pose's evidence (`bound`): they would be the same answer, no better.
-  bool InBasin(const FeasibleRegion& region, double bound) const {
-    if (basins_ == nullptr) return false;
-    return std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
-      return bound <= b.evidence && region.Within(b.pose, b.radius_m, b.heading_rad);
-    });
+  // True when the region lies in the neighbourhood of a verified pose and its leaves cannot reach
+  // that pose's evidence (`bound`): they would be the same answer, no better.
+  bool InNeighbourhood(const FeasibleRegion& region, double bound) const {
+    if (neighbourhoods_ == nullptr) return false;
+    return std::any_of(
+        neighbourhoods_->begin(), neighbourhoods_->end(), [&](const VerifiedNeighbourhood& b) {
+          return bound <= b.evidence && region.Within(b.pose, b.radius_m, b.heading_rad);
+        });
   }
 
   void VisitLeaf(const std::vector<char>& alive, const FeasibleRegion& region) {
@@ -383,11 +382,12 @@ class TreeSearch {
     // A leaf consistent with a verified pose would be verified into it again: its region holds
     // the pose and it assigns no line otherwise than the pose does (a line fitting the pose with
     // another edge). A leaf giving a line to another edge is another interpretation, however wide
-    // its region (3-sigma gates) is: verified (docs/matching-rounds.md, fourth round).
-    if (basins_ != nullptr &&
-        std::any_of(basins_->begin(), basins_->end(), [&](const VerifiedBasin& b) {
-          return !AssignsLineOtherwise(assigned_, b.fitting) && region.Contains(b.pose);
-        })) {
+    // its region (3-sigma gates) is: verified.
+    if (neighbourhoods_ != nullptr &&
+        std::any_of(
+            neighbourhoods_->begin(), neighbourhoods_->end(), [&](const VerifiedNeighbourhood& b) {
+              return !AssignsLineOtherwise(assigned_, b.consensus) && region.Contains(b.pose);
+            })) {
       return;
     }
     Hypothesis leaf{assigned_, region, assigned_caps_};
@@ -451,7 +451,7 @@ class TreeSearch {
   const InterpretationTreeOptions& options_;
   const LeafVisitor& visit_;
   InterpretationTreeStats* stats_;
-  const std::vector<VerifiedBasin>* basins_;
+  const std::vector<VerifiedNeighbourhood>* neighbourhoods_;
   Gate gate_;
   std::vector<double> caps_;
   std::vector<int> order_;  // lines by decreasing cap
@@ -474,13 +474,13 @@ class TreeSearch {
   double assigned_caps_ = 0.0;
   double pass_bound_ = 0.0;
   // Budgets: the options' own, or a share of them for each unsearched branch (Resume).
-  int node_cap_ = options_.max_nodes, leaf_cap_ = options_.max_hypotheses,
-      check_cap_ = options_.max_checks;
+  int node_limit_ = options_.max_nodes, leaf_limit_ = options_.max_hypotheses,
+      check_limit_ = options_.max_checks;
   double visitor_bound_ = 0.0;
   std::set<std::vector<std::pair<int, int>>> visited_;
-  // Per basin: which candidates fit its pose, and how many assigned pairs do.
-  std::vector<std::vector<char>> basin_flags_;
-  std::vector<int> basin_fit_;
+  // Per neighbourhood: which candidates fit its pose, and how many assigned pairs do.
+  std::vector<std::vector<char>> consensus_flags_;
+  std::vector<int> consensus_fit_;
   mutable std::vector<std::optional<HeadingInterval>> angle_ranges_;
 };
 
@@ -499,25 +499,19 @@ bool InterpretationTreeOptions::Check(std::string* why) const {
   return true;
 }
 
-void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins) {
+void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTreeOptions& options,
+                              const LeafVisitor& visit, InterpretationTreeStats* stats,
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Run();
+  TreeSearch(problem, options, visit, stats, neighbourhoods).Run();
 }
 
-void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps,
+void SearchUnsearchedBranches(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins) {
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods) {
   *stats = InterpretationTreeStats();
-  TreeSearch(edges, lines, prior, options, line_caps, visit, stats, basins).Resume(branches);
+  TreeSearch(problem, options, visit, stats, neighbourhoods).Resume(branches);
 }
 
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
@@ -527,7 +521,7 @@ std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,
                                            InterpretationTreeStats* stats) {
   std::vector<Hypothesis> leaves;
   SearchInterpretationTree(
-      edges, lines, prior, options, {},
+      {&edges, &lines, &prior, nullptr}, options,
       [&](const Hypothesis& h) {
         leaves.push_back(h);
         return 0.0;

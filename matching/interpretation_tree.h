@@ -45,18 +45,6 @@ struct InterpretationTreeOptions {
   bool Check(std::string* why) const;
 };
 
-// The prior: disk of positions and interval of headings, at known height (metres).
-struct PriorRegion {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  double radius = 0.0;
-  HeadingInterval heading;
-  double height = 0.0;
-  double focal_px = 1000.0;  // mean focal length of the camera (pixels)
-  // When set, camera positions lie in this box (the navigable area's bounds).
-  bool has_bounds = false;
-  Eigen::Vector2d bounds_min = Eigen::Vector2d::Zero(), bounds_max = Eigen::Vector2d::Zero();
-};
-
 // A leaf: (edge index, line index) pairs into the given edge and line lists, and the pose region
 // the correspondences share.
 struct Hypothesis {
@@ -67,27 +55,27 @@ struct Hypothesis {
   double bound = 0.0;
 };
 
-// A pose already verified and what would be verified into it again: subtrees whose region lies
+// A plausible verified pose and what would be verified into it again: subtrees whose region lies
 // in its neighbourhood (radius_m, heading_rad) unless their bound exceeds its evidence (the
 // verified pose may hold a wrong pair; a better leaf there is a better version of the same
-// answer), leaves whose region holds the pose, and subtrees
-// all of whose leaves would have most of their pairs among `fitting` (the pairs that fit the
-// pose) and fewer lines than it explains.
-struct VerifiedBasin {
+// answer), leaves whose region holds the pose, and subtrees all of whose leaves would have most
+// of their pairs in its consensus set and fewer lines than it explains.
+struct VerifiedNeighbourhood {
   Pose3Dof pose;
-  // Its neighbourhood (basin_sigmas standard deviations).
+  // Its neighbourhood: neighbourhood_sigmas standard deviations of position and heading.
   double radius_m = 0.0;
   double heading_rad = 0.0;
   int lines = 0;          // lines the verified pose explains
-  double evidence = 0.0;  // its evidence (nats): a subtree in its basin must be able to beat it
-  std::vector<std::pair<int, int>> fitting;  // (edge index, line index), sorted
+  double evidence = 0.0;  // its evidence (nats): a subtree in its neighbourhood must beat it
+  // Its consensus set (ConsensusSet): (edge index, line index) pairs within the gate, sorted.
+  std::vector<std::pair<int, int>> consensus;
 };
 
 // True when `pairs` (edge index, line index) give a line to another edge than a verified pose
-// does: a pair not in the pose's `fitting` pairs (sorted) whose line is in one of them. Such a
-// leaf is another interpretation, not the verified pose again, even when its region holds it.
+// does: a pair not in the pose's consensus set (sorted) whose line is in one of its pairs. Such
+// a leaf is another interpretation, not the verified pose again, even when its region holds it.
 bool AssignsLineOtherwise(const std::vector<std::pair<int, int>>& pairs,
-                          const std::vector<std::pair<int, int>>& fitting);
+                          const std::vector<std::pair<int, int>>& consensus);
 
 // The root's branches an exhausted search did not reach in the pass the budget stopped: the
 // root's line (index into the lines), the edges it was still to take (indices into the edges; -1:
@@ -113,33 +101,36 @@ struct InterpretationTreeStats {
   UnsearchedBranches unsearched;  // set when the budget stopped the root's first branch
 };
 
+// What the tree searches: the candidate edges and the image lines (leaves' pairs index into
+// them), the prior region, and each line's cap (nats; null or empty: 1 per line, so that bounds
+// count lines).
+struct TreeProblem {
+  const std::vector<MatchEdge>* edges = nullptr;
+  const std::vector<ObservedLine>* lines = nullptr;
+  const PriorRegion* prior = nullptr;
+  const std::vector<double>* line_caps = nullptr;
+};
+
 // Called on leaves in search order, each distinct leaf once, when its bound reaches the current
 // one. Returns the smallest bound still worth exploring (the best evidence found less the
 // ambiguity margin); return 0 to keep the current one.
 using LeafVisitor = std::function<double(const Hypothesis&)>;
 
-// Searches the tree depth first, assignments (longest lines first) before skips. `line_caps`
-// holds each line's cap (nats); empty means 1 per line (bounds count lines). `basins` (may be
-// null; the visitor may add to it) are read at every node. Deterministic: the same input gives
-// the same leaves in the same order.
-void SearchInterpretationTree(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps, const LeafVisitor& visit,
-                              InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins = nullptr);
+// Searches the tree depth first, assignments (lines by decreasing cap) before skips.
+// `neighbourhoods` (may be null; the visitor may add to it) are read at every node. Deterministic:
+// the same input gives the same leaves in the same order.
+void SearchInterpretationTree(const TreeProblem& problem, const InterpretationTreeOptions& options,
+                              const LeafVisitor& visit, InterpretationTreeStats* stats,
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods = nullptr);
 
-// Searches the root branches an exhausted search (same edges, lines, prior and caps) did not
-// reach, at the bound of the pass it stopped in, each with an equal share of the options'
-// budgets; leaves as SearchInterpretationTree. `stats->budget_exhausted` stays set (the pass
-// is still not complete).
-void SearchUnsearchedBranches(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const InterpretationTreeOptions& options,
-                              const std::vector<double>& line_caps,
+// Searches the root branches an exhausted search of the same problem did not reach, at the
+// bound of the pass it stopped in, each with an equal share of the options' budgets; leaves as
+// SearchInterpretationTree. `stats->budget_exhausted` stays set (the pass is still not
+// complete).
+void SearchUnsearchedBranches(const TreeProblem& problem, const InterpretationTreeOptions& options,
                               const UnsearchedBranches& branches, const LeafVisitor& visit,
                               InterpretationTreeStats* stats,
-                              const std::vector<VerifiedBasin>* basins = nullptr);
+                              const std::vector<VerifiedNeighbourhood>* neighbourhoods = nullptr);
 
 // All leaves with at least options.min_matches correspondences (no bound).
 std::vector<Hypothesis> GenerateHypotheses(const std::vector<MatchEdge>& edges,

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 
 #include "models/geometry.h"
@@ -47,6 +48,12 @@ struct LineFit {
   double log_likelihood_ratio = -std::numeric_limits<double>::infinity();
   bool gated = false;  // chi2 and overhang within the model's gates
 };
+
+// True when the spans of two fits along one projected edge overlap by more than `tolerance`
+// pixels (two lines cannot both be that stretch of the edge's image).
+inline bool SpansOverlap(const LineFit& a, const LineFit& b, double tolerance) {
+  return std::min(a.hi, b.hi) - std::max(a.lo, b.lo) > tolerance;
+}
 
 // Covariance of the two endpoint residuals for levers t_a, t_b (pixels along the line from the
 // rotation centre): sigma_d^2 [1 1; 1 1] + sigma_theta^2 [t_a^2 t_a t_b; t_a t_b t_b^2].

@@ -7,6 +7,9 @@
 #include <numeric>
 #include <set>
 
+#include "matching/hypothesis_trimming.h"
+#include "matching/pose_decision.h"
+#include "matching/reported_pairs.h"
 #include "matching/unreported_doubt.h"
 #include "models/errors.h"
 
@@ -81,13 +84,19 @@ std::vector<int> Localizer::CandidateEdges(const LocalizationProblem& problem) c
     std::iota(all.begin(), all.end(), 0);
     return all;
   }
+  return regions_->Query(VisibilityQueryOf(problem, camera_));
+}
+
+VisibilityQuery VisibilityQueryOf(const LocalizationProblem& problem,
+                                  const CameraIntrinsics& camera) {
   VisibilityQuery query;
   query.centre = {problem.prior.x, problem.prior.y};
   query.radius = problem.delta_t;
   query.heading = problem.prior.heading;
   query.heading_margin = problem.delta_phi;
-  query.bearing_half_width = BearingHalfWidth(camera_, problem.tilt, problem.tilt);
-  return regions_->Query(query);
+  query.bearing_half_width = BearingHalfWidth(camera, problem.tilt, problem.tilt);
+  query.camera_z = problem.height;
+  return query;
 }
 
 namespace {
@@ -113,6 +122,295 @@ bool AlreadyVerified(const VerifiedPose& leaf, const std::vector<RematchedHypoth
   return false;
 }
 
+std::vector<std::pair<int, int>> Sorted(std::vector<std::pair<int, int>> pairs) {
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// The tree's leaves verified as the search finds them: the pose of the leaf's correspondences
+// (Levenberg-Marquardt, trimmed to consistency), then guided matching and the evidence. The
+// bound handed back to the search is the best evidence found less the ambiguity margin; a leaf
+// that a verified pose already covers is not verified again.
+class LeafVerifier {
+ public:
+  LeafVerifier(const VerificationContext& context, const VerificationOptions& options)
+      : context_(context), options_(options) {}
+
+  // The search's leaf visitor: verifies `h` unless covered; returns the bound to continue with
+  // (infinite once the pair-test budget is spent: the search stops).
+  double Visit(const Hypothesis& h) {
+    if (Covered(h)) return Bound();
+    if (stats_.pair_tests >= options_.max_pair_tests) {
+      budget_exhausted_ = true;
+      return std::numeric_limits<double>::infinity();
+    }
+    ++hypotheses_;
+    VerifiedPose leaf = RefineHypothesis(context_, h.pairs, h.region.Representatives(), options_);
+    if (!TrimHypothesis(context_, options_, &leaf, &memo_) ||
+        HypothesisEvidence(context_, options_, leaf) < Bound()) {
+      return Bound();
+    }
+    // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
+    // agreeing pairs): guided matching from it would give the same pose again, which the
+    // verified poses, neighbourhoods and best evidence already hold. Its share of the work budget
+    // still counts.
+    std::vector<RematchedHypothesis>& known = rematched_[Sorted(leaf.pairs)];
+    if (AlreadyVerified(leaf, known, &stats_.pair_tests)) return Bound();
+    const long tests_before = stats_.pair_tests;
+    VerifiedPose v = Rematch(context_, leaf, options_, &stats_);
+    known.push_back({leaf.pose, leaf.refinement.focal_scale, stats_.pair_tests - tests_before});
+    Record(std::move(v));
+    return Bound();
+  }
+
+  // A fresh share of the pair-test budget for a further search: the count restarts at
+  // (1 - share) of the budget.
+  void GiveBudgetShare(double share) {
+    stats_.pair_tests =
+        static_cast<long>((1.0 - share) * static_cast<double>(options_.max_pair_tests));
+  }
+
+  const std::vector<VerifiedPose>& verified() const { return verified_; }
+  std::vector<VerifiedPose> TakeVerified() { return std::move(verified_); }
+  const std::vector<VerifiedNeighbourhood>* neighbourhoods() const { return &neighbourhoods_; }
+  int hypotheses() const { return hypotheses_; }
+  bool budget_exhausted() const { return budget_exhausted_; }
+
+ private:
+  double Bound() const { return std::isfinite(best_) ? best_ - options_.ambiguity_nats : 0.0; }
+
+  // True when verifying `h` would give a verified pose again: its pairs all belong to one, or it
+  // mostly fits a verified pose that explains more lines, or entirely fits one that explains as
+  // many.
+  bool Covered(const Hypothesis& h) const {
+    for (const auto& pairs : verified_pairs_) {
+      if (std::all_of(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+            return std::binary_search(pairs.begin(), pairs.end(), p);
+          })) {
+        return true;
+      }
+    }
+    const int size = static_cast<int>(h.pairs.size());
+    for (const VerifiedNeighbourhood& b : neighbourhoods_) {
+      if (size > b.lines) continue;  // neither test below can hold: no pair counted
+      const int fit =
+          static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
+            return std::binary_search(b.consensus.begin(), b.consensus.end(), p);
+          }));
+      if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) return true;
+    }
+    return false;
+  }
+
+  // Keeps a verified leaf. Leaves that would be verified into a plausible pose again are not
+  // verified: those whose region holds it or lies within neighbourhood_sigmas of its standard
+  // deviations, and those most of whose pairs fit it.
+  void Record(VerifiedPose v) {
+    if (v.plausible) {
+      CompleteEvidence(context_, options_, &v);
+      best_ = std::max(best_, v.evidence.Score());
+      neighbourhoods_.push_back({v.pose,
+                                 options_.neighbourhood_sigmas * v.refinement.position_sigma_m,
+                                 options_.neighbourhood_sigmas * v.refinement.heading_sigma_rad,
+                                 static_cast<int>(v.pairs.size()), v.evidence.Score(),
+                                 ConsensusSet(context_, options_, v)});
+    }
+    verified_pairs_.push_back(Sorted(v.pairs));
+    verified_.push_back(std::move(v));
+  }
+
+  const VerificationContext& context_;
+  const VerificationOptions& options_;
+  std::vector<VerifiedPose> verified_;
+  std::vector<std::vector<std::pair<int, int>>> verified_pairs_;  // each sorted
+  std::vector<VerifiedNeighbourhood> neighbourhoods_;
+  double best_ = -std::numeric_limits<double>::infinity();
+  VerificationStats stats_;
+  ConsensusMemo memo_;
+  // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
+  std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched_;
+  int hypotheses_ = 0;
+  bool budget_exhausted_ = false;
+};
+
+// Each line's cap for the tree's bound: cap_efficiency times the largest log-likelihood ratio
+// against clutter it can reach (MaxLogLikelihoodRatio).
+std::vector<double> LineCaps(const VerificationContext& context,
+                             const VerificationOptions& options) {
+  const LineFitModel fit_model = FitModel(context, options);
+  std::vector<double> caps;
+  for (const ObservedLine& line : *context.lines) {
+    caps.push_back(options.cap_efficiency *
+                   (MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density));
+  }
+  return caps;
+}
+
+// The tree options with `share` of each of their budgets (nodes, checks, leaves; at least one).
+InterpretationTreeOptions WithBudgetShare(InterpretationTreeOptions tree, double share) {
+  tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
+  tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
+  tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
+  return tree;
+}
+
+// The match of a verified pose for the result: (model edge id, line index).
+Finalist FinalistOf(const VerifiedPose& v, const std::vector<MatchEdge>& edges) {
+  Finalist f{v.pose, v.matched_edges, v.mean_distance_px, v.evidence, {}};
+  for (const auto& [e, l] : v.pairs)
+    f.matches.emplace_back(edges[e].edge_id, l);
+  return f;
+}
+
+// An exhausted search may have missed the pose that explains the lines its best pose leaves
+// unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the tree
+// is searched again over those lines alone, with fresh budgets (unexplained_search_share), its
+// leaves verified against all lines; when that finds nothing better, over the lines the best
+// pose does not explain with a reported correspondence (it may hold contested true lines).
+void SearchUnexplainedLines(const VerificationContext& context, const LocalizerOptions& options,
+                            const std::vector<double>& caps, LeafVerifier* leaves,
+                            LocalizationResult* result) {
+  const std::vector<ObservedLine>& lines = *context.lines;
+  std::vector<bool> searched;
+  double searched_from = -std::numeric_limits<double>::infinity();
+  for (const bool reported_only : {false, true}) {
+    const VerifiedPose* top = nullptr;
+    for (const VerifiedPose& v : leaves->verified()) {
+      if (v.plausible && (top == nullptr || v.evidence.Score() > top->evidence.Score())) top = &v;
+    }
+    if (top == nullptr || (reported_only && top->evidence.Score() > searched_from)) return;
+    std::vector<bool> explained(lines.size(), false);
+    for (const auto& pair : reported_only ? top->confident_pairs : top->pairs)
+      explained[pair.second] = true;
+    if (explained == searched) return;
+    searched = explained;
+    searched_from = top->evidence.Score();
+    std::vector<ObservedLine> rest;
+    std::vector<double> rest_caps;
+    for (size_t l = 0; l < lines.size(); ++l) {
+      if (explained[l]) continue;
+      rest.push_back(lines[l]);
+      rest_caps.push_back(caps[l]);
+    }
+    if (static_cast<int>(rest.size()) < options.tree.min_matches) continue;
+    // Leaves over `rest` are handed on with the line indices of the full list
+    // (ObservedLine::index is the position in it), with a fresh verification budget. `top` may
+    // dangle from here on: the visitor adds to the verified poses.
+    const double share = options.unexplained_search_share;
+    leaves->GiveBudgetShare(share);
+    InterpretationTreeStats stats;
+    SearchInterpretationTree(
+        {context.edges, &rest, context.prior, &rest_caps}, WithBudgetShare(options.tree, share),
+        [&](const Hypothesis& h) {
+          Hypothesis full = h;
+          for (auto& pair : full.pairs)
+            pair.second = rest[pair.second].index;
+          return leaves->Visit(full);
+        },
+        &stats, nullptr);
+    result->tree_nodes += stats.nodes;
+    result->tree_checks += stats.checks;
+    result->unexplained_completed_bound =
+        std::max(result->unexplained_completed_bound, stats.completed_bound);
+  }
+}
+
+// Depth first, the first root branch can take the whole budget while the root's other branches
+// have the same bound: the branches `branches` the exhausted main search did not reach are
+// searched with unsearched_branches_share of its budgets (a fresh share of the pair tests).
+void SearchUnsearchedRootBranches(const VerificationContext& context,
+                                  const LocalizerOptions& options, const std::vector<double>& caps,
+                                  const UnsearchedBranches& branches, LeafVerifier* leaves,
+                                  LocalizationResult* result) {
+  const double share = options.unsearched_branches_share;
+  leaves->GiveBudgetShare(share);
+  InterpretationTreeStats stats;
+  SearchUnsearchedBranches(
+      {context.edges, context.lines, context.prior, &caps}, WithBudgetShare(options.tree, share),
+      branches, [leaves](const Hypothesis& h) { return leaves->Visit(h); }, &stats,
+      leaves->neighbourhoods());
+  result->tree_nodes += stats.nodes;
+  result->tree_checks += stats.checks;
+}
+
+// The interpretation tree searched as a branch and bound on the evidence, its leaves verified as
+// they are found: nodes and leaves whose bound (the caps of the lines they could explain) cannot
+// come within the ambiguity margin of the best evidence found are cut. Then, after an exhausted
+// budget, the searches over unexplained lines and over unsearched root branches.
+std::vector<VerifiedPose> SearchTree(const VerificationContext& context,
+                                     const LocalizerOptions& options, LocalizationResult* result) {
+  const std::vector<double> caps = LineCaps(context, options.verification);
+  LeafVerifier leaves(context, options.verification);
+  InterpretationTreeStats stats;
+  SearchInterpretationTree(
+      {context.edges, context.lines, context.prior, &caps}, options.tree,
+      [&leaves](const Hypothesis& h) { return leaves.Visit(h); }, &stats, leaves.neighbourhoods());
+  result->unary_candidates = stats.unary_candidates;
+  result->tree_nodes = stats.nodes;
+  result->tree_checks = stats.checks;
+  result->tree_completed_bound = stats.completed_bound;
+  if ((leaves.budget_exhausted() || stats.budget_exhausted) &&
+      options.unexplained_search_share > 0.0) {
+    SearchUnexplainedLines(context, options, caps, &leaves, result);
+  }
+  if (!stats.unsearched.edges.empty() && options.unsearched_branches_share > 0.0) {
+    SearchUnsearchedRootBranches(context, options, caps, stats.unsearched, &leaves, result);
+  }
+  result->hypotheses = leaves.hypotheses();
+  result->budget_exhausted = leaves.budget_exhausted() || stats.budget_exhausted;
+  return leaves.TakeVerified();
+}
+
+// Picks the answer among the verified poses (pose_decision.h: ranking with the leave-one-out
+// rivals, ambiguity, the evidence needed, the report) and fills `result`: the finalists, and
+// when a pose is accepted, its reported correspondences and covariance.
+void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
+            const VerificationOptions& options, LocalizationResult* result) {
+  const std::vector<MatchEdge>& edges = *context.edges;
+  if (!RankPoses(context, options, &verified, &result->reason)) return;
+  const VerifiedPose& best = verified.front();
+  const std::vector<size_t> distinct = DistinctPoses(verified, options);
+  for (const size_t i : distinct)
+    result->finalists.push_back(FinalistOf(verified[i], edges));
+  result->support = best.evidence.Support();
+  result->score_px = best.score_px;
+  if (!ClearlyBest(context, options, distinct, &verified, &result->reason)) return;
+  const double score = best.evidence.Score();
+  const double required = RequiredEvidence(context, options, best);
+  if (score < required) {
+    result->reason =
+        "weak evidence (" + std::to_string(score) + " of " + std::to_string(required) + " nats)";
+    return;
+  }
+  // Only correspondences that also beat every rival line at the pose of the others are reported.
+  const std::vector<std::pair<int, int>> reported = PairsBeatingRivalLines(context, options, best);
+  std::set<int> confident_edges;
+  for (const auto& pair : reported)
+    confident_edges.insert(pair.first);
+  if (static_cast<int>(confident_edges.size()) < options.min_confident_edges) {
+    result->reason =
+        "too few uncontested correspondences (" + std::to_string(confident_edges.size()) + ")";
+    return;
+  }
+  result->found = true;
+  result->pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
+  result->cam_from_world = CamFromWorld(result->pose);
+  std::vector<DoubtedGroup> groups;
+  const Eigen::Matrix4d covariance = AnswerCovariance(context, options, best, reported, &groups);
+  for (const DoubtedGroup& group : groups) {
+    DoubtedMatches doubted{{}, group.probability_true};
+    for (const auto& [e, l] : group.pairs)
+      doubted.matches.emplace_back(edges[e].edge_id, l);
+    result->doubted.push_back(std::move(doubted));
+  }
+  result->covariance = covariance.topLeftCorner<3, 3>();
+  result->heading_sigma_rad = std::sqrt(covariance(0, 0));
+  result->position_sigma_m = LargestPositionSigma(covariance.block<2, 2>(1, 1));
+  for (const auto& [e, l] : reported)
+    result->matches.emplace_back(edges[e].edge_id, l);
+  std::sort(result->matches.begin(), result->matches.end());
+}
+
 }  // namespace
 
 PriorRegion Localizer::Prior(const LocalizationProblem& problem) const {
@@ -136,309 +434,29 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   LocalizationResult result;
   const std::vector<int> ids = CandidateEdges(problem);
   result.candidate_edges = static_cast<int>(ids.size());
+  if (ids.empty()) {
+    result.reason = "no candidate edge: " +
+                    (regions_ != nullptr && !problem.candidate_edges
+                         ? regions_->ExplainEmptyQuery(VisibilityQueryOf(problem, camera_))
+                         : std::string(problem.candidate_edges ? "the given list is empty"
+                                                               : "the model has no edges"));
+    return result;
+  }
   const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
   const std::vector<ObservedLine> lines = PrepareLines(
       problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
-
   const PriorRegion prior = Prior(problem);
-  VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
-                              &occlusion_, &prior, area_,    options_.noise};
+  const VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
+                                    &occlusion_, &prior, area_,    options_.noise};
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
-    // Leaves are verified as the search finds them: the pose of the leaf's correspondences
-    // (Levenberg-Marquardt, trimmed to consistency), then guided matching and the evidence.
-    // Branch and bound: leaves and nodes whose bound (the caps of the lines they could explain)
-    // cannot come within the ambiguity margin of the best evidence found are cut; a leaf whose
-    // pairs all belong to a pose already verified would converge to it and is skipped.
-    InterpretationTreeStats stats;
-    const VerificationOptions& vo = options_.verification;
-    const LineFitModel fit_model = FitModel(context, vo);
-    std::vector<double> caps;
-    for (const ObservedLine& line : lines)
-      caps.push_back(vo.cap_efficiency *
-                     (MaxLogLikelihoodRatio(line.length_px, fit_model) - line.clutter_log_density));
-    double best = -std::numeric_limits<double>::infinity();
-    std::vector<std::vector<std::pair<int, int>>> verified_pairs;
-    std::vector<VerifiedBasin> basins;
-    long pair_tests = 0;
-    context.pair_tests = &pair_tests;
-    ConsensusMemo consensus_memo;
-    context.consensus_memo = &consensus_memo;
-    // Trimmed hypotheses already verified, with the guided-matching pair tests each cost.
-    std::map<std::vector<std::pair<int, int>>, std::vector<RematchedHypothesis>> rematched;
-    const LeafVisitor visit = [&](const Hypothesis& h) {
-      const double bound = std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
-      for (const auto& pairs : verified_pairs) {
-        if (std::all_of(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
-              return std::binary_search(pairs.begin(), pairs.end(), p);
-            })) {
-          return bound;
-        }
-      }
-      // Mostly fitting a verified pose that explains more lines, or entirely fitting one that
-      // explains as many: verified into it again.
-      const int size = static_cast<int>(h.pairs.size());
-      for (const VerifiedBasin& b : basins) {
-        if (size > b.lines) continue;  // neither test below can hold: no pair counted
-        const int fit =
-            static_cast<int>(std::count_if(h.pairs.begin(), h.pairs.end(), [&](const auto& p) {
-              return std::binary_search(b.fitting.begin(), b.fitting.end(), p);
-            }));
-        if ((size < b.lines && 2 * fit > size) || (size <= b.lines && fit == size)) {
-          return bound;
-        }
-      }
-      if (pair_tests >= vo.max_pair_tests) {
-        result.budget_exhausted = true;
-        return std::numeric_limits<double>::infinity();  // stops the search
-      }
-      ++result.hypotheses;
-      VerifiedPose leaf = RefineHypothesis(context, h.pairs, h.region.Representatives(), vo);
-      if (!TrimHypothesis(context, vo, &leaf) || HypothesisEvidence(context, vo, leaf) < bound) {
-        return bound;
-      }
-      // Sibling leaves often trim to the same hypothesis (the consensus restart keeps the same
-      // agreeing pairs): guided matching from it would give the same pose again, which the
-      // verified poses, basins and best evidence already hold. Its share of the work budget still
-      // counts.
-      std::vector<std::pair<int, int>> trimmed = leaf.pairs;
-      std::sort(trimmed.begin(), trimmed.end());
-      std::vector<RematchedHypothesis>& known = rematched[std::move(trimmed)];
-      if (AlreadyVerified(leaf, known, &pair_tests)) {
-        return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
-      }
-      const long tests_before = pair_tests;
-      VerifiedPose v = Rematch(context, leaf, vo);
-      known.push_back({leaf.pose, leaf.refinement.focal_scale, pair_tests - tests_before});
-      if (v.plausible) {
-        CompleteEvidence(context, vo, &v);
-        best = std::max(best, v.evidence.Score());
-        // Leaves that would be verified into this pose again are not verified: those whose
-        // region holds it or lies within basin_sigmas of its standard deviations, and those
-        // most of whose pairs fit it.
-        basins.push_back({v.pose, vo.basin_sigmas * v.refinement.position_sigma_m,
-                          vo.basin_sigmas * v.refinement.heading_sigma_rad,
-                          static_cast<int>(v.pairs.size()), v.evidence.Score(),
-                          FittingPairs(context, vo, v)});
-      }
-      std::vector<std::pair<int, int>> pairs = v.pairs;
-      std::sort(pairs.begin(), pairs.end());
-      verified_pairs.push_back(std::move(pairs));
-      verified.push_back(std::move(v));
-      return std::isfinite(best) ? best - vo.ambiguity_nats : 0.0;
-    };
-    SearchInterpretationTree(edges, lines, prior, options_.tree, caps, visit, &stats, &basins);
-    result.unary_candidates = stats.unary_candidates;
-    result.tree_nodes = stats.nodes;
-    result.tree_checks = stats.checks;
-    result.tree_completed_bound = stats.completed_bound;
-    result.budget_exhausted = result.budget_exhausted || stats.budget_exhausted;
-    if (result.budget_exhausted && options_.unexplained_search_share > 0.0) {
-      SearchUnexplainedLines(edges, lines, prior, caps, verified, visit, &pair_tests, &result);
-    }
-    if (!stats.unsearched.edges.empty() && options_.unsearched_branches_share > 0.0) {
-      SearchUnsearchedRootBranches(edges, lines, prior, caps, stats.unsearched, visit, &basins,
-                                   &pair_tests, &result);
-    }
-    context.pair_tests = nullptr;
-    context.consensus_memo = nullptr;
+    verified = SearchTree(context, options_, &result);
   } else {
     verified = options_.sampler(context, prior, options_.verification, &result.samples);
-  }
-  if (options_.method != MatchMethod::kInterpretationTree) {
     result.hypotheses = static_cast<int>(verified.size());
   }
-  Decide(std::move(verified), context, edges, &result);
+  Decide(std::move(verified), context, options_.verification, &result);
   return result;
-}
-
-void Localizer::SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
-                                       const std::vector<ObservedLine>& lines,
-                                       const PriorRegion& prior, const std::vector<double>& caps,
-                                       const std::vector<VerifiedPose>& verified,
-                                       const LeafVisitor& visit, long* pair_tests,
-                                       LocalizationResult* result) const {
-  // First the lines the best pose does not explain at all; when that finds nothing better, the
-  // lines it does not explain with a reported correspondence (it may hold contested true lines).
-  std::vector<bool> searched;
-  double searched_from = -std::numeric_limits<double>::infinity();
-  for (const bool reported_only : {false, true}) {
-    const VerifiedPose* top = nullptr;
-    for (const VerifiedPose& v : verified) {
-      if (v.plausible && (top == nullptr || v.evidence.Score() > top->evidence.Score())) top = &v;
-    }
-    if (top == nullptr || (reported_only && top->evidence.Score() > searched_from)) return;
-    std::vector<bool> explained(lines.size(), false);
-    for (const auto& pair : reported_only ? top->confident_pairs : top->pairs)
-      explained[pair.second] = true;
-    if (explained == searched) return;
-    searched = explained;
-    searched_from = top->evidence.Score();
-    std::vector<ObservedLine> rest;
-    std::vector<double> rest_caps;
-    for (size_t l = 0; l < lines.size(); ++l) {
-      if (explained[l]) continue;
-      rest.push_back(lines[l]);
-      rest_caps.push_back(caps[l]);
-    }
-    if (static_cast<int>(rest.size()) < options_.tree.min_matches) continue;
-    // Leaves over `rest` are handed on with the line indices of the full list
-    // (ObservedLine::index is the position in it), with a fresh verification budget. `top` may
-    // dangle from here on: the visitor adds to `verified`.
-    const double share = options_.unexplained_search_share;
-    *pair_tests = static_cast<long>((1.0 - share) *
-                                    static_cast<double>(options_.verification.max_pair_tests));
-    InterpretationTreeOptions tree = options_.tree;
-    tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
-    tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
-    tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
-    InterpretationTreeStats stats;
-    SearchInterpretationTree(
-        edges, rest, prior, tree, rest_caps,
-        [&](const Hypothesis& h) {
-          Hypothesis full = h;
-          for (auto& pair : full.pairs)
-            pair.second = rest[pair.second].index;
-          return visit(full);
-        },
-        &stats, nullptr);
-    result->tree_nodes += stats.nodes;
-    result->tree_checks += stats.checks;
-    result->unexplained_completed_bound =
-        std::max(result->unexplained_completed_bound, stats.completed_bound);
-  }
-}
-
-void Localizer::SearchUnsearchedRootBranches(
-    const std::vector<MatchEdge>& edges, const std::vector<ObservedLine>& lines,
-    const PriorRegion& prior, const std::vector<double>& caps, const UnsearchedBranches& branches,
-    const LeafVisitor& visit, const std::vector<VerifiedBasin>* basins, long* pair_tests,
-    LocalizationResult* result) const {
-  const double share = options_.unsearched_branches_share;
-  *pair_tests =
-      static_cast<long>((1.0 - share) * static_cast<double>(options_.verification.max_pair_tests));
-  InterpretationTreeOptions tree = options_.tree;
-  tree.max_nodes = std::max(1, static_cast<int>(share * tree.max_nodes));
-  tree.max_checks = std::max(1, static_cast<int>(share * tree.max_checks));
-  tree.max_hypotheses = std::max(1, static_cast<int>(share * tree.max_hypotheses));
-  InterpretationTreeStats stats;
-  SearchUnsearchedBranches(edges, lines, prior, tree, caps, branches, visit, &stats, basins);
-  result->tree_nodes += stats.nodes;
-  result->tree_checks += stats.checks;
-}
-
-void Localizer::Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
-                       const std::vector<MatchEdge>& edges, LocalizationResult* out) const {
-  LocalizationResult& result = *out;
-  const VerificationOptions& vo = options_.verification;
-  if (verified.empty()) {
-    result.reason = "no consistent hypothesis";
-    return;
-  }
-  for (VerifiedPose& v : verified) {
-    if (v.plausible) CompleteEvidence(context, vo, &v);
-  }
-  std::stable_sort(verified.begin(), verified.end(), BetterThan);
-  if (!verified.front().plausible) {
-    result.reason = "no plausible pose (best: " + verified.front().implausible_because + ")";
-    return;
-  }
-  // The best pose's rivals hidden by one of its correspondences join the comparison.
-  for (VerifiedPose& rival : LeaveOneOutRivals(context, vo, verified.front())) {
-    if (rival.plausible) CompleteEvidence(context, vo, &rival);
-    verified.push_back(std::move(rival));
-  }
-  std::stable_sort(verified.begin(), verified.end(), BetterThan);
-  const VerifiedPose& best = verified.front();
-  // Finalists: the best pose, then the best of each distinct other pose (diagnostics).
-  auto finalist = [&](const VerifiedPose& v) {
-    Finalist f{v.pose, v.matched_edges, v.mean_distance_px, v.evidence, {}};
-    for (const auto& [e, l] : v.pairs)
-      f.matches.emplace_back(edges[e].edge_id, l);
-    return f;
-  };
-  result.finalists.push_back(finalist(best));
-  std::vector<Pose3Dof> distinct = {best.pose};
-  for (const VerifiedPose& v : verified) {
-    if (!v.plausible) break;
-    if (std::any_of(distinct.begin(), distinct.end(),
-                    [&](const Pose3Dof& d) { return SamePose(d, v.pose, vo); })) {
-      continue;
-    }
-    distinct.push_back(v.pose);
-    result.finalists.push_back(finalist(v));
-  }
-  result.support = best.evidence.Support();
-  result.score_px = best.score_px;
-  const double score = best.evidence.Score();
-  if (result.finalists.size() > 1 &&
-      score - result.finalists[1].evidence.Score() < vo.ambiguity_nats) {
-    result.reason = "ambiguous: another pose explains the image almost as well";
-    return;
-  }
-  // An unobservable pose inside the prior (or one held at its border) is a rival explanation
-  // too: when a distinct one comes within the margin, the accepted pose is not clearly the best
-  // explanation of the lines.
-  for (VerifiedPose& v : verified) {
-    if (!v.unobservable || v.evidence.lines_nats < score - vo.ambiguity_nats ||
-        SamePose(v.pose, best.pose, vo)) {
-      continue;  // the edges term is not positive: lines_nats bounds the evidence
-    }
-    CompleteEvidence(context, vo, &v);
-    if (v.evidence.Score() > score - vo.ambiguity_nats) {
-      result.reason = "ambiguous: " +
-                      std::string(v.implausible_because == "unobservable"
-                                      ? "an unobservable pose"
-                                      : "a pose held at the prior's border") +
-                      " explains the image almost as well";
-      return;
-    }
-  }
-  const double required = RequiredEvidence(context, vo, best);
-  if (score < required) {
-    result.reason =
-        "weak evidence (" + std::to_string(score) + " of " + std::to_string(required) + " nats)";
-    return;
-  }
-  // Only correspondences that also beat every rival line at the pose of the others are reported.
-  const std::vector<std::pair<int, int>> reported = PairsBeatingRivalLines(context, vo, best);
-  std::set<int> confident_edges;
-  for (const auto& pair : reported)
-    confident_edges.insert(pair.first);
-  if (static_cast<int>(confident_edges.size()) < vo.min_confident_edges) {
-    result.reason =
-        "too few uncontested correspondences (" + std::to_string(confident_edges.size()) + ")";
-    return;
-  }
-  result.found = true;
-  result.pose = {best.pose.x, best.pose.y, best.pose.heading, context.height, context.tilt};
-  result.cam_from_world = CamFromWorld(result.pose);
-  // The answer's precision comes from the pairs it vouches for: not from an unreported pair that
-  // alone fixes a direction of the pose (kept when the others leave the pose unobservable).
-  VerifiedPose vouched = best;
-  vouched.refinement = VouchedRefinement(context, vo, best, reported, &vouched.pairs);
-  vouched.pose = vouched.refinement.pose;
-  const bool observable =
-      vouched.refinement.position_sigma_m <= vo.max_position_sigma_m &&
-      vouched.refinement.heading_sigma_rad <= DegToRad(vo.max_heading_sigma_deg);
-  const VerifiedPose& base = observable ? vouched : best;
-  // And it averages over what the unreported pairs it keeps are (true or clutter).
-  std::vector<DoubtedGroup> groups;
-  const Eigen::Matrix4d covariance = vo.doubt_unreported_pairs
-                                         ? DoubtedCovariance(context, vo, base, reported, &groups)
-                                         : base.refinement.covariance;
-  for (const DoubtedGroup& group : groups) {
-    DoubtedMatches doubted{{}, group.probability_true};
-    for (const auto& [e, l] : group.pairs)
-      doubted.matches.emplace_back(edges[e].edge_id, l);
-    result.doubted.push_back(std::move(doubted));
-  }
-  result.covariance = covariance.topLeftCorner<3, 3>();
-  result.heading_sigma_rad = std::sqrt(covariance(0, 0));
-  result.position_sigma_m = LargestPositionSigma(covariance.block<2, 2>(1, 1));
-  for (const auto& [e, l] : reported)
-    result.matches.emplace_back(edges[e].edge_id, l);
-  std::sort(result.matches.begin(), result.matches.end());
 }
 
 }  // namespace linetrack

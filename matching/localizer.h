@@ -46,8 +46,8 @@ struct LocalizerOptions {
   double unexplained_search_share = 0.25;
   // Budgets of the search of the root branches an exhausted main search did not reach in the
   // pass it stopped in (after the searches over unexplained lines), as a share of the main
-  // search's: depth first, the first branch can take the whole budget (docs/matching-rounds.md,
-  // ninth round).
+  // search's: depth first, the root's first branch can take the whole budget while its siblings
+  // have the same bound.
   double unsearched_branches_share = 0.1;
 
   bool Check(std::string* why) const;
@@ -59,7 +59,7 @@ struct LocalizationProblem {
   Pose3Dof prior;          // x, y (metres), heading (radians)
   double delta_t = 0.0;    // prior position bound (metres)
   double delta_phi = 0.0;  // prior heading bound (radians)
-  double height = 0.0;     // camera height (metres)
+  double height = 0.0;     // camera height: world z of the optical centre (metres)
   double tilt = 0.0;       // camera tilt (radians, positive down)
   // When set, these model edge ids are the candidates instead of the view-invariant regions'
   // answer (e.g. a tracker that knows which edges it sees).
@@ -95,8 +95,8 @@ struct LocalizationResult {
   int hypotheses = 0;   // hypotheses verified (pose evaluations)
   int samples = 0;      // baseline only: random pairs drawn
   bool budget_exhausted = false;
-  // The main tree search's InterpretationTreeStats::completed_bound (nats): leaves it did not
-  // visit have a bound below it when the budget ran out (docs/matching-rounds.md, eighth round).
+  // The main tree search's InterpretationTreeStats::completed_bound (nats): when the budget ran
+  // out, the leaves it did not visit have a bound below it.
   double tree_completed_bound = 0.0;
   // The largest completed_bound of the searches over unexplained lines (0 when none ran).
   double unexplained_completed_bound = 0.0;
@@ -109,7 +109,8 @@ struct LocalizationResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
-  // The doubted groups behind `covariance` (docs/matching-rounds.md, ninth round).
+  // The unreported pairs `covariance` averages over, grouped by edge, with their posterior
+  // (DoubtedCovariance, unreported_doubt.h).
   std::vector<DoubtedMatches> doubted;
 };
 
@@ -139,32 +140,6 @@ class Localizer {
   const OcclusionTester& occlusion() const { return occlusion_; }
 
  private:
-  // An exhausted search may have missed the pose that explains the lines its best pose leaves
-  // unexplained (a wrong pose borrowing a few true lines hides the truth from the bound): the
-  // tree is searched again over those lines alone, with fresh budgets, its leaves handed to
-  // `visit` (which verifies them against all lines); when that finds nothing better, over the
-  // lines it does not explain with a reported correspondence.
-  void SearchUnexplainedLines(const std::vector<MatchEdge>& edges,
-                              const std::vector<ObservedLine>& lines, const PriorRegion& prior,
-                              const std::vector<double>& caps,
-                              const std::vector<VerifiedPose>& verified, const LeafVisitor& visit,
-                              long* pair_tests, LocalizationResult* result) const;
-
-  // Searches the root branches `branches` the exhausted main search did not reach, with
-  // unsearched_branches_share of its budgets (a fresh share of the pair tests), its leaves handed
-  // to `visit`.
-  void SearchUnsearchedRootBranches(const std::vector<MatchEdge>& edges,
-                                    const std::vector<ObservedLine>& lines,
-                                    const PriorRegion& prior, const std::vector<double>& caps,
-                                    const UnsearchedBranches& branches, const LeafVisitor& visit,
-                                    const std::vector<VerifiedBasin>* basins, long* pair_tests,
-                                    LocalizationResult* result) const;
-
-  // Picks the pose among the verified hypotheses (finalists scored with occlusion, ambiguity
-  // and support checks) and fills `result`.
-  void Decide(std::vector<VerifiedPose> verified, const VerificationContext& context,
-              const std::vector<MatchEdge>& edges, LocalizationResult* result) const;
-
   const WireframeModel& model_;
   const ViewInvariantRegions* regions_;
   const NavigableArea* area_;
@@ -175,5 +150,10 @@ class Localizer {
 
 // Throws InputError naming the field when the problem is malformed.
 void CheckProblem(const LocalizationProblem& problem);
+
+// The view-invariant regions' question for a problem's prior: its disk and heading interval, the
+// image's bearing half-width at its tilt, the camera's height (world z, which picks the storey).
+VisibilityQuery VisibilityQueryOf(const LocalizationProblem& problem,
+                                  const CameraIntrinsics& camera);
 
 }  // namespace linetrack

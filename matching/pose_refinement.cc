@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "matching/constraints.h"
+#include "matching/pose_refinement_steps.h"
 
 namespace linetrack {
 
@@ -29,9 +30,9 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   double height, double tilt, const Pose3Dof& pose,
                                   Eigen::Matrix<double, 2, 3>* jacobian) {
   if (jacobian == nullptr)
-    return EndpointResiduals(match, camera, height, tilt, pose, 1.0, nullptr);
+    return EndpointResiduals(match, camera, ViewOf(pose, height, tilt), 1.0, nullptr);
   Eigen::Matrix<double, 2, 4> j4;
-  const Eigen::Vector2d r = EndpointResiduals(match, camera, height, tilt, pose, 1.0, &j4);
+  const Eigen::Vector2d r = EndpointResiduals(match, camera, ViewOf(pose, height, tilt), 1.0, &j4);
   *jacobian = j4.leftCols<3>();
   return r;
 }
@@ -44,13 +45,6 @@ PoseView ViewOf(const Pose3Dof& pose, double height, double tilt) {
   d_level_from_world << ch, sh, 0.0, 0.0, 0.0, 0.0, -sh, ch, 0.0;
   return {cam_from_level * level_from_world, cam_from_level * d_level_from_world,
           Eigen::Vector3d(pose.x, pose.y, height)};
-}
-
-Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const CameraIntrinsics& camera, double height, double tilt,
-                                  const Pose3Dof& pose, double scale,
-                                  Eigen::Matrix<double, 3, 4>* derivative) {
-  return ProjectedEdgeLine(a, b, camera, ViewOf(pose, height, tilt), scale, derivative);
 }
 
 Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -88,9 +82,10 @@ Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3
 }
 
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
-                                  double height, double tilt, const Pose3Dof& pose, double scale,
+                                  double height, double tilt, const PoseAndScale& pose,
                                   Eigen::Matrix<double, 2, 4>* jacobian) {
-  return EndpointResiduals(match, camera, ViewOf(pose, height, tilt), scale, jacobian);
+  return EndpointResiduals(match, camera, ViewOf(pose.pose, height, tilt), pose.focal_scale,
+                           jacobian);
 }
 
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
@@ -111,7 +106,7 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options) {
-  return RefinePose(matches, camera, height, tilt, start, 1.0, options);
+  return RefinePose(matches, camera, height, tilt, PoseAndScale{start, 1.0}, options);
 }
 
 namespace {
@@ -192,230 +187,288 @@ Eigen::Vector2d BoundsResiduals(const PoseBounds& bounds, const Pose3Dof& pose, 
   return r;
 }
 
+RefinementProblem MakeRefinementProblem(const std::vector<LineMatch>& matches,
+                                        const CameraIntrinsics& camera, double height, double tilt,
+                                        const PoseRefinementOptions& options) {
+  RefinementProblem problem{&matches, &camera, height, tilt, &options};
+  // With enough lines the focal scale s absorbs a calibration error: MAP with the prior
+  // s ~ N(1, focal_prior_sigma).
+  problem.with_scale = options.focal_prior_sigma > 0.0 &&
+                       static_cast<int>(matches.size()) >= options.min_matches_for_scale;
+  problem.dof = problem.with_scale ? 4 : 3;
+  problem.prior_weight = problem.with_scale ? 1.0 / options.focal_prior_sigma : 0.0;
+  return problem;
+}
+
+double HuberCost(double r, double huber_px) {
+  const double a = std::abs(r);
+  return huber_px > 0.0 && a > huber_px ? huber_px * (2.0 * a - huber_px) : a * a;
+}
+
+namespace {
+
+// The Huber weight of a whitened residual: 1 within the threshold, huber_px / |r| beyond.
+double HuberWeight(double r, double huber_px) {
+  const double a = std::abs(r);
+  return huber_px > 0.0 && a > huber_px ? huber_px / a : 1.0;
+}
+
+// Adds the scale prior's terms, (prior_weight (s - 1))^2 in the cost, to normal equations.
+void AddScalePrior(const RefinementProblem& problem, double scale, NormalEquations* system) {
+  const double w2 = problem.prior_weight * problem.prior_weight;
+  system->jtj(3, 3) += w2;
+  system->jtr(3) += w2 * (scale - 1.0);
+}
+
+}  // namespace
+
+Linearization Linearize(const RefinementProblem& problem, const Pose3Dof& pose, double scale,
+                        Weighting weighting) {
+  const bool robust = weighting != Weighting::kPlain;
+  const bool plain = weighting != Weighting::kRobust;
+  const bool both = robust && plain;
+  const double huber_px = problem.options->huber_px;
+  Linearization out;
+  const PoseView view = ViewOf(pose, problem.height, problem.tilt);
+  for (const LineMatch& m : *problem.matches) {
+    Eigen::Matrix<double, 2, 4> j;
+    const Eigen::Vector2d raw = EndpointResiduals(m, *problem.camera, view, scale, &j);
+    out.squares_px2 += raw.squaredNorm();
+    const Eigen::Vector2d r = m.whitening * raw;
+    out.chi2 += r.squaredNorm();
+    if (both) out.huber_cost += HuberCost(r[0], huber_px) + HuberCost(r[1], huber_px);
+    j = m.whitening * j;
+    if (!problem.with_scale) j.col(3).setZero();
+    for (int k = 0; k < 2; ++k) {
+      if (robust) {
+        const double w = HuberWeight(r[k], huber_px);
+        out.robust.jtj += w * j.row(k).transpose() * j.row(k);
+        out.robust.jtr += w * j.row(k).transpose() * r[k];
+      }
+      if (plain) {
+        out.plain.jtj += j.row(k).transpose() * j.row(k);
+        out.plain.jtr += j.row(k).transpose() * r[k];
+      }
+    }
+  }
+  if (problem.with_scale) {
+    if (robust) AddScalePrior(problem, scale, &out.robust);
+    if (plain) AddScalePrior(problem, scale, &out.plain);
+  }
+  return out;
+}
+
+bool OutsideUnwidened(const PoseBounds& bounds, const Pose3Dof& pose) {
+  return bounds.active &&
+         (std::hypot(pose.x - bounds.centre.x(), pose.y - bounds.centre.y()) > bounds.radius_m ||
+          std::abs(WrapAngle(pose.heading - bounds.heading)) > bounds.half_width_rad);
+}
+
+BoundsBorder BorderOf(const RefinementProblem& problem, const Eigen::Matrix4d& information) {
+  const PoseBounds& bounds = problem.options->bounds;
+  const auto [position_sigma, heading_sigma] = SigmasOf(information, problem.dof);
+  return {bounds.radius_m + Widening(bounds, position_sigma),
+          bounds.half_width_rad + Widening(bounds, heading_sigma)};
+}
+
+const BoundsBorder& StepBorder(const RefinementProblem& problem, RefinementState* state) {
+  if (!state->border_ready) {
+    const Linearization plain = Linearize(problem, state->pose, state->scale, Weighting::kPlain);
+    state->border = BorderOf(problem, plain.plain.jtj);
+    state->border_ready = true;
+  }
+  return state->border;
+}
+
+double TrialCost(const RefinementProblem& problem, const Pose3Dof& pose, double scale,
+                 const BoundsBorder* border) {
+  double cost = 0.0;
+  const double huber_px = problem.options->huber_px;
+  const PoseView view = ViewOf(pose, problem.height, problem.tilt);
+  for (const LineMatch& m : *problem.matches) {
+    const Eigen::Vector2d r =
+        m.whitening * EndpointResiduals(m, *problem.camera, view, scale, nullptr);
+    cost += HuberCost(r[0], huber_px) + HuberCost(r[1], huber_px);
+  }
+  const double p = problem.prior_weight * (scale - 1.0);
+  if (border != nullptr) {
+    cost += BoundsResiduals(problem.options->bounds, pose, border->radius_m, border->half_width_rad)
+                .squaredNorm();
+  }
+  return cost + p * p;
+}
+
+RefinementState IterationZero(const RefinementProblem& problem, const Pose3Dof& start,
+                              double start_scale) {
+  RefinementState state;
+  state.pose = start;
+  state.scale = start_scale;
+  const BoundsBorder* border =
+      OutsideUnwidened(problem.options->bounds, start) ? &StepBorder(problem, &state) : nullptr;
+  state.cost = TrialCost(problem, start, start_scale, border);
+  return state;
+}
+
+NormalEquations IterateNormalEquations(const RefinementProblem& problem, RefinementState* state) {
+  state->border_ready = false;
+  const PoseBounds& bounds = problem.options->bounds;
+  // Inside: the cost at the iterate has no bounds term whatever the border.
+  if (!OutsideUnwidened(bounds, state->pose))
+    return Linearize(problem, state->pose, state->scale, Weighting::kRobust).robust;
+  // The robust normal equations, the plain information (the step's border) and the Huber cost
+  // at the iterate, in one pass; then the bounds' residuals at that border.
+  Linearization both = Linearize(problem, state->pose, state->scale, Weighting::kRobustAndPlain);
+  state->border = BorderOf(problem, both.plain.jtj);
+  state->border_ready = true;
+  Eigen::Matrix<double, 2, 3> jb;
+  const Eigen::Vector2d rb = BoundsResiduals(bounds, state->pose, state->border.radius_m,
+                                             state->border.half_width_rad, &jb);
+  both.robust.jtj.topLeftCorner<3, 3>() += jb.transpose() * jb;
+  both.robust.jtr.head<3>() += jb.transpose() * rb;
+  const double p = problem.prior_weight * (state->scale - 1.0);
+  state->cost = both.huber_cost + rb.squaredNorm() + p * p;
+  return both.robust;
+}
+
+namespace {
+
+// (A + lambda diag(A) + 1e-12 I)^-1 (-b) at fixed size (no allocation).
+template <typename Matrix, typename Gradient>
+auto SolveDamped(Matrix damped, const Gradient& gradient, double lambda) {
+  damped.diagonal() *= 1.0 + lambda;
+  damped.diagonal().array() += 1e-12;
+  return (-damped.ldlt().solve(gradient)).eval();
+}
+
+}  // namespace
+
+Eigen::Vector4d DampedStep(const NormalEquations& system, double lambda, int dof) {
+  Eigen::Vector4d step = Eigen::Vector4d::Zero();
+  if (dof == 4) {
+    step = SolveDamped(Eigen::Matrix4d(system.jtj), system.jtr, lambda);
+  } else {
+    step.head<3>() = SolveDamped(Eigen::Matrix3d(system.jtj.topLeftCorner<3, 3>()),
+                                 system.jtr.head<3>(), lambda);
+  }
+  return step;
+}
+
+bool IsStepSuccessful(double trial_cost, double cost, double trial_scale) {
+  return std::isfinite(trial_cost) && trial_cost <= cost && trial_scale > 0.5;
+}
+
+double DampingAfterSuccess(double lambda) {
+  return std::max(lambda * 0.3, 1e-9);
+}
+
+double DampingAfterFailure(double lambda) {
+  return lambda * 10.0;
+}
+
+StepOutcome TakeStep(const RefinementProblem& problem, const NormalEquations& system,
+                     RefinementState* state) {
+  StepOutcome out;
+  for (int attempt = 0; attempt < 8 && !out.accepted; ++attempt) {
+    out.step = DampedStep(system, state->lambda, problem.dof);
+    const Pose3Dof trial{state->pose.x + out.step[1], state->pose.y + out.step[2],
+                         state->pose.heading + out.step[0]};
+    const double trial_scale = state->scale + out.step[3];
+    const BoundsBorder* border =
+        OutsideUnwidened(problem.options->bounds, trial) ? &StepBorder(problem, state) : nullptr;
+    const double trial_cost = TrialCost(problem, trial, trial_scale, border);
+    if (IsStepSuccessful(trial_cost, state->cost, trial_scale)) {
+      state->pose = trial;
+      state->scale = trial_scale;
+      state->cost = trial_cost;
+      state->lambda = DampingAfterSuccess(state->lambda);
+      out.accepted = true;
+    } else {
+      state->lambda = DampingAfterFailure(state->lambda);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// Where the final pose lies outside the unwidened bounds: the border widened by the final
+// sigmas, how far the pose exceeds it, whether the bounds hold the pose, and the covariance of the
+// cost minimised (the image information plus the bounds' residuals', Gauss-Newton).
+void BoundsAtTheEnd(const RefinementProblem& problem, const NormalEquations& robust,
+                    Eigen::Matrix4d information, PoseRefinementResult* result) {
+  const PoseBounds& bounds = problem.options->bounds;
+  const int dof = problem.dof;
+  const double radius = bounds.radius_m + Widening(bounds, result->position_sigma_m);
+  const double half_width = bounds.half_width_rad + Widening(bounds, result->heading_sigma_rad);
+  Eigen::Matrix<double, 2, 3> jb;
+  const Eigen::Vector2d rb = BoundsResiduals(bounds, result->pose, radius, half_width, &jb);
+  result->bounds_excess_m = rb[0] * bounds.softness_m;
+  result->bounds_excess_rad = rb[1] * bounds.softness_rad;
+  // Held: outside by a hair, or stopped inside where the image's (robust) Gauss-Newton step
+  // leads out of the bounds (LM stops at the wall when the border grows with the sigmas).
+  Eigen::Vector4d step = Eigen::Vector4d::Zero();
+  step.head(dof) = -robust.jtj.topLeftCorner(dof, dof).ldlt().solve(robust.jtr.head(dof));
+  const Pose3Dof target{result->pose.x + step[1], result->pose.y + step[2],
+                        result->pose.heading + step[0]};
+  result->held_by_bounds = rb.squaredNorm() > 0.0 || !step.allFinite() ||
+                           BoundsResiduals(bounds, target, radius, half_width).squaredNorm() > 0.0;
+  if (!(rb.squaredNorm() > 0.0)) return;
+  information.topLeftCorner<3, 3>() += jb.transpose() * jb;
+  // The disk's curvature: rb_0 times the Hessian of (d - R) / softness, (I - n n') / (d
+  // softness) across the radius (the multiplier times the border's curvature; not small where
+  // the image pulls hard). The heading residual is linear.
+  if (rb[0] > 0.0) {
+    const Eigen::Vector2d offset(result->pose.x - bounds.centre.x(),
+                                 result->pose.y - bounds.centre.y());
+    const double distance = offset.norm();
+    const Eigen::Vector2d n = offset / distance;
+    information.block<2, 2>(1, 1) +=
+        rb[0] / (distance * bounds.softness_m) * (Eigen::Matrix2d::Identity() - n * n.transpose());
+  }
+  double position_sigma = 0.0, heading_sigma = 0.0;
+  UncertaintyOf(information, dof, &result->bounded_covariance, &position_sigma, &heading_sigma);
+}
+
+// The result at the final iterate: the residuals' summary and the covariance of the plain normal
+// equations (and, where the bounds may hold the pose, the robust ones for the held test, in the
+// same pass).
+void Summarize(const RefinementProblem& problem, PoseRefinementResult* result) {
+  const bool outside = OutsideUnwidened(problem.options->bounds, result->pose);
+  const Linearization end = Linearize(problem, result->pose, result->focal_scale,
+                                      outside ? Weighting::kRobustAndPlain : Weighting::kPlain);
+  result->chi2 = end.chi2;
+  result->rms_px = std::sqrt(end.squares_px2 / (2.0 * problem.matches->size()));
+  // Pose uncertainty: the inverse of the information (the scale, when estimated, included).
+  UncertaintyOf(end.plain.jtj, problem.dof, &result->covariance, &result->position_sigma_m,
+                &result->heading_sigma_rad);
+  result->bounded_covariance = result->covariance;
+  if (outside) BoundsAtTheEnd(problem, end.robust, end.plain.jtj, result);
+}
+
+}  // namespace
+
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
-                                const Pose3Dof& start, double start_scale,
-                                const PoseRefinementOptions& options) {
+                                const PoseAndScale& start, const PoseRefinementOptions& options) {
   PoseRefinementResult result;
-  result.pose = start;
-  result.focal_scale = start_scale;
+  result.pose = start.pose;
+  result.focal_scale = start.focal_scale;
   if (matches.empty()) return result;
-  const int n = static_cast<int>(matches.size());
-  // Parameters (heading, x, y) and, with enough lines, the focal scale s, which absorbs a
-  // calibration error: MAP with the prior s ~ N(1, focal_prior_sigma).
-  const bool with_scale = options.focal_prior_sigma > 0.0 && n >= options.min_matches_for_scale;
-  const int dof = with_scale ? 4 : 3;
-  const double prior_weight = with_scale ? 1.0 / options.focal_prior_sigma : 0.0;
-  const PoseBounds& bounds = options.bounds;
-  auto huber = [&](double r) {
-    const double a = std::abs(r);
-    return options.huber_px > 0.0 && a > options.huber_px
-               ? options.huber_px * (2.0 * a - options.huber_px)
-               : a * a;
-  };
-  auto weight = [&](double r) {
-    const double a = std::abs(r);
-    return options.huber_px > 0.0 && a > options.huber_px ? options.huber_px / a : 1.0;
-  };
-  // One pass over the pairs at (pose, scale): the normal equations of the whitened residuals,
-  // Huber-weighted when `robust`, in (jtj, jtr); optionally those of the other weighting in
-  // (other_jtj, other_jtr) and the Huber cost in *huber_cost. Returns the raw sum of squared pixel
-  // residuals and (in *chi2) of the whitened ones.
-  auto normal_equations = [&](const Pose3Dof& pose, double scale, bool robust, Eigen::Matrix4d* jtj,
-                              Eigen::Vector4d* jtr, double* chi2,
-                              Eigen::Matrix4d* other_jtj = nullptr,
-                              Eigen::Vector4d* other_jtr = nullptr, double* huber_cost = nullptr) {
-    jtj->setZero();
-    jtr->setZero();
-    if (other_jtj != nullptr) {
-      other_jtj->setZero();
-      other_jtr->setZero();
-    }
-    if (huber_cost != nullptr) *huber_cost = 0.0;
-    double squares = 0.0;
-    *chi2 = 0.0;
-    const PoseView view = ViewOf(pose, height, tilt);
-    for (const LineMatch& m : matches) {
-      Eigen::Matrix<double, 2, 4> j;
-      const Eigen::Vector2d raw = EndpointResiduals(m, camera, view, scale, &j);
-      squares += raw.squaredNorm();
-      const Eigen::Vector2d r = m.whitening * raw;
-      *chi2 += r.squaredNorm();
-      if (huber_cost != nullptr) *huber_cost += huber(r[0]) + huber(r[1]);
-      j = m.whitening * j;
-      if (!with_scale) j.col(3).setZero();
-      for (int k = 0; k < 2; ++k) {
-        const double w = robust ? weight(r[k]) : 1.0;
-        *jtj += w * j.row(k).transpose() * j.row(k);
-        *jtr += w * j.row(k).transpose() * r[k];
-        if (other_jtj != nullptr) {
-          const double v = robust ? 1.0 : weight(r[k]);
-          *other_jtj += v * j.row(k).transpose() * j.row(k);
-          *other_jtr += v * j.row(k).transpose() * r[k];
-        }
-      }
-    }
-    if (with_scale) {
-      (*jtj)(3, 3) += prior_weight * prior_weight;
-      (*jtr)(3) += prior_weight * prior_weight * (scale - 1.0);
-      if (other_jtj != nullptr) {
-        (*other_jtj)(3, 3) += prior_weight * prior_weight;
-        (*other_jtr)(3) += prior_weight * prior_weight * (scale - 1.0);
-      }
-    }
-    return squares;
-  };
-  // The bounds' border, widened by the image evidence's sigmas from the plain information
-  // `plain_jtj` at a pose; only used when the pose leaves the unwidened region (else no residual).
-  auto outside_unwidened = [&](const Pose3Dof& pose) {
-    return bounds.active &&
-           (std::hypot(pose.x - bounds.centre.x(), pose.y - bounds.centre.y()) > bounds.radius_m ||
-            std::abs(WrapAngle(pose.heading - bounds.heading)) > bounds.half_width_rad);
-  };
-  auto border_of = [&](const Eigen::Matrix4d& plain_jtj) {
-    const auto [position_sigma, heading_sigma] = SigmasOf(plain_jtj, dof);
-    return std::make_pair(bounds.radius_m + Widening(bounds, position_sigma),
-                          bounds.half_width_rad + Widening(bounds, heading_sigma));
-  };
-  // The border of the current step: widened by the sigmas of the image evidence at the iterate,
-  // held fixed during the step's trials as the bounds' Jacobian holds them (the trials then need
-  // the residuals only). Computed when first needed in a step (most refinements stay inside).
-  std::pair<double, double> border{bounds.radius_m, bounds.half_width_rad};
-  bool border_ready = false;
-  auto step_border = [&]() {
-    if (!border_ready) {
-      Eigen::Matrix4d plain_jtj;
-      Eigen::Vector4d plain_jtr;
-      double plain_chi2 = 0.0;
-      normal_equations(result.pose, result.focal_scale, false, &plain_jtj, &plain_jtr, &plain_chi2);
-      border = border_of(plain_jtj);
-      border_ready = true;
-    }
-    return border;
-  };
-  auto cost_at = [&](const Pose3Dof& pose, double scale) {
-    double cost = 0.0;
-    const PoseView view = ViewOf(pose, height, tilt);
-    for (const LineMatch& m : matches) {
-      const Eigen::Vector2d r = m.whitening * EndpointResiduals(m, camera, view, scale, nullptr);
-      cost += huber(r[0]) + huber(r[1]);
-    }
-    const double p = prior_weight * (scale - 1.0);
-    if (outside_unwidened(pose)) {
-      const auto [radius, half_width] = step_border();
-      cost += BoundsResiduals(bounds, pose, radius, half_width).squaredNorm();
-    }
-    return cost + p * p;
-  };
-
-  double lambda = 1e-3;
-  double cost = cost_at(result.pose, result.focal_scale);
-  Eigen::Matrix4d jtj;
-  Eigen::Vector4d jtr;
-  double chi2 = 0.0;
+  const RefinementProblem problem = MakeRefinementProblem(matches, camera, height, tilt, options);
+  RefinementState state = IterationZero(problem, start.pose, start.focal_scale);
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
-    border_ready = false;
-    if (!outside_unwidened(result.pose)) {
-      // Inside: the cost at the iterate has no bounds term whatever the border.
-      normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2);
-    } else {
-      // The robust normal equations, the plain information (the step's border) and the cost at
-      // the iterate under that border, in one pass.
-      Eigen::Matrix4d plain_jtj;
-      Eigen::Vector4d plain_jtr;
-      double huber_cost = 0.0;
-      normal_equations(result.pose, result.focal_scale, true, &jtj, &jtr, &chi2, &plain_jtj,
-                       &plain_jtr, &huber_cost);
-      border = border_of(plain_jtj);
-      border_ready = true;
-      Eigen::Matrix<double, 2, 3> jb;
-      const Eigen::Vector2d rb =
-          BoundsResiduals(bounds, result.pose, border.first, border.second, &jb);
-      jtj.topLeftCorner<3, 3>() += jb.transpose() * jb;
-      jtr.head<3>() += jb.transpose() * rb;
-      const double p = prior_weight * (result.focal_scale - 1.0);
-      cost = huber_cost + rb.squaredNorm() + p * p;
-    }
-    bool improved = false;
-    Eigen::Vector4d step = Eigen::Vector4d::Zero();
-    for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
-      // The damped step, solved at fixed size (no allocation).
-      auto damped_step = [&](auto damped, const auto& gradient) {
-        damped.diagonal() *= 1.0 + lambda;
-        damped.diagonal().array() += 1e-12;
-        return (-damped.ldlt().solve(gradient)).eval();
-      };
-      if (with_scale) {
-        step = damped_step(Eigen::Matrix4d(jtj), jtr);
-      } else {
-        step.head<3>() = damped_step(Eigen::Matrix3d(jtj.topLeftCorner<3, 3>()), jtr.head<3>());
-      }
-      const Pose3Dof trial{result.pose.x + step[1], result.pose.y + step[2],
-                           result.pose.heading + step[0]};
-      const double trial_scale = result.focal_scale + step[3];
-      const double trial_cost = cost_at(trial, trial_scale);
-      if (std::isfinite(trial_cost) && trial_cost <= cost && trial_scale > 0.5) {
-        result.pose = trial;
-        result.focal_scale = trial_scale;
-        cost = trial_cost;
-        lambda = std::max(lambda * 0.3, 1e-9);
-        improved = true;
-      } else {
-        lambda *= 10.0;
-      }
-    }
-    if (!improved || step.norm() < options.step_tolerance) {
-      result.converged = improved || step.norm() < options.step_tolerance;
+    const StepOutcome step = TakeStep(problem, IterateNormalEquations(problem, &state), &state);
+    const bool small = step.step.norm() < options.step_tolerance;
+    if (!step.accepted || small) {
+      result.converged = step.accepted || small;
       break;
     }
   }
+  result.pose = state.pose;
+  result.focal_scale = state.scale;
   result.pose.heading = WrapAngle(result.pose.heading);
-  // The plain normal equations at the end (and, where the bounds may hold the pose, the robust
-  // ones for the held test) in one pass.
-  const bool outside = outside_unwidened(result.pose);
-  Eigen::Matrix4d robust_jtj;
-  Eigen::Vector4d robust_jtr;
-  const double squares =
-      normal_equations(result.pose, result.focal_scale, false, &jtj, &jtr, &result.chi2,
-                       outside ? &robust_jtj : nullptr, outside ? &robust_jtr : nullptr);
-  result.rms_px = std::sqrt(squares / (2.0 * n));
-  // Pose uncertainty: the inverse of the information (the scale, when estimated, included).
-  UncertaintyOf(jtj, dof, &result.covariance, &result.position_sigma_m, &result.heading_sigma_rad);
-  result.bounded_covariance = result.covariance;
-  if (outside) {
-    // Where the pose is held at the border, the cost minimised has the bounds' information too.
-    const double radius = bounds.radius_m + Widening(bounds, result.position_sigma_m);
-    const double half_width = bounds.half_width_rad + Widening(bounds, result.heading_sigma_rad);
-    Eigen::Matrix<double, 2, 3> jb;
-    const Eigen::Vector2d rb = BoundsResiduals(bounds, result.pose, radius, half_width, &jb);
-    result.bounds_excess_m = rb[0] * bounds.softness_m;
-    result.bounds_excess_rad = rb[1] * bounds.softness_rad;
-    // Held: outside by a hair, or stopped inside where the image's (robust) Gauss-Newton step
-    // leads out of the bounds (LM stops at the wall when the border grows with the sigmas).
-    Eigen::Vector4d step = Eigen::Vector4d::Zero();
-    step.head(dof) = -robust_jtj.topLeftCorner(dof, dof).ldlt().solve(robust_jtr.head(dof));
-    const Pose3Dof target{result.pose.x + step[1], result.pose.y + step[2],
-                          result.pose.heading + step[0]};
-    result.held_by_bounds = rb.squaredNorm() > 0.0 || !step.allFinite() ||
-                            BoundsResiduals(bounds, target, radius, half_width).squaredNorm() > 0.0;
-    if (rb.squaredNorm() > 0.0) {
-      jtj.topLeftCorner<3, 3>() += jb.transpose() * jb;
-      // The disk's curvature: rb_0 times the Hessian of (d - R) / softness, (I - n n') / (d
-      // softness) across the radius (the multiplier times the border's curvature; not small
-      // where the image pulls hard). The heading residual is linear.
-      if (rb[0] > 0.0) {
-        const Eigen::Vector2d offset(result.pose.x - bounds.centre.x(),
-                                     result.pose.y - bounds.centre.y());
-        const double distance = offset.norm();
-        const Eigen::Vector2d n = offset / distance;
-        jtj.block<2, 2>(1, 1) += rb[0] / (distance * bounds.softness_m) *
-                                 (Eigen::Matrix2d::Identity() - n * n.transpose());
-      }
-      double position_sigma = 0.0, heading_sigma = 0.0;
-      UncertaintyOf(jtj, dof, &result.bounded_covariance, &position_sigma, &heading_sigma);
-    }
-  }
+  Summarize(problem, &result);
   return result;
 }
 

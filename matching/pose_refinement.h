@@ -24,8 +24,9 @@ struct LineMatch {
   Eigen::Matrix2d whitening = Eigen::Matrix2d::Identity();
 };
 
-// The region a refined pose may not leave (docs/matching-rounds.md, fifth round): the disk
-// of radius radius_m + sigmas * position sigma around centre, and headings within half_width_rad
+// The region a refined pose may not leave (the prior: a hypothesis' pairs alone may pull the pose
+// along a weakly observed direction far out of it): the disk of radius radius_m + sigmas *
+// position sigma around centre, and headings within half_width_rad
 // + sigmas * heading sigma of `heading`, the sigmas those of the image evidence at the pose
 // (PoseRefinementResult::position_sigma_m, heading_sigma_rad; RefinePose takes them at each step's
 // iterate and holds them during the step's trials). Outside it the cost gains the
@@ -101,14 +102,17 @@ struct PoseView {
 };
 PoseView ViewOf(const Pose3Dof& pose, double height, double tilt);
 
-// The image line of the model edge through a and b (world) seen from `pose` with the focal
+// A 3-DOF pose with the focal scale of the camera that sees it: px and py times focal_scale (the
+// calibration error estimated with the pose).
+struct PoseAndScale {
+  Pose3Dof pose;
+  double focal_scale = 1.0;
+};
+
+// The image line of the model edge through a and b (world) seen from `view` with the focal
 // lengths scaled by `scale`: (l_u, l_v, l_c) with l_u u + l_v v + l_c = 0 and l_u^2 + l_v^2 = 1
 // (pixels; the line through the projections of a and b). `derivative` (optional) gets
 // d line / d (heading, x, y, scale).
-Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                  const CameraIntrinsics& camera, double height, double tilt,
-                                  const Pose3Dof& pose, double scale,
-                                  Eigen::Matrix<double, 3, 4>* derivative);
 Eigen::Vector3d ProjectedEdgeLine(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                   const CameraIntrinsics& camera, const PoseView& view,
                                   double scale, Eigen::Matrix<double, 3, 4>* derivative);
@@ -119,10 +123,10 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
                                   double height, double tilt, const Pose3Dof& pose,
                                   Eigen::Matrix<double, 2, 3>* jacobian = nullptr);
 
-// The same with the focal lengths scaled by `scale`; `jacobian` (optional) gets
+// The same with the focal lengths scaled by pose.focal_scale; `jacobian` (optional) gets
 // d residual / d (heading, x, y, scale).
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
-                                  double height, double tilt, const Pose3Dof& pose, double scale,
+                                  double height, double tilt, const PoseAndScale& pose,
                                   Eigen::Matrix<double, 2, 4>* jacobian);
 Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics& camera,
                                   const PoseView& view, double scale,
@@ -133,14 +137,14 @@ Eigen::Vector2d EndpointResiduals(const LineMatch& match, const CameraIntrinsics
 double LargestPositionSigma(const Eigen::Matrix2d& position_covariance);
 
 // Refines `start` by Levenberg-Marquardt on all whitened endpoint residuals (Huber-weighted),
-// with the focal scale too when the options ask for it (starting from `start_scale`), and the
-// residuals of options.bounds when active.
+// with the focal scale too when the options ask for it (starting from start.focal_scale), and
+// the residuals of options.bounds when active (steps in pose_refinement_steps.h).
+PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
+                                const CameraIntrinsics& camera, double height, double tilt,
+                                const PoseAndScale& start, const PoseRefinementOptions& options);
+// The same from focal scale 1.
 PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
                                 const CameraIntrinsics& camera, double height, double tilt,
                                 const Pose3Dof& start, const PoseRefinementOptions& options);
-PoseRefinementResult RefinePose(const std::vector<LineMatch>& matches,
-                                const CameraIntrinsics& camera, double height, double tilt,
-                                const Pose3Dof& start, double start_scale,
-                                const PoseRefinementOptions& options);
 
 }  // namespace linetrack

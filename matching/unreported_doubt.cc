@@ -1,5 +1,3 @@
-// The accepted pose's covariance averaged over its unreported pairs: law of total covariance over
-// "the group is true" / "the group is clutter" (docs/matching-rounds.md, ninth round).
 #include "matching/unreported_doubt.h"
 
 #include <algorithm>
@@ -9,7 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "matching/verification_internal.h"
+#include "matching/reported_pairs.h"
 
 namespace linetrack {
 
@@ -51,9 +49,9 @@ bool DeletedGroupPose(const VerificationContext& context, const VerifiedPose& ve
   for (size_t k = 0; k < matches.size(); ++k) {
     Eigen::Matrix<double, 2, 4> jk;
     r.segment<2>(2 * k) =
-        matches[k].whitening * EndpointResiduals(matches[k], *context.camera, context.height,
-                                                 context.tilt, verified.pose,
-                                                 verified.refinement.focal_scale, &jk);
+        matches[k].whitening *
+        EndpointResiduals(matches[k], *context.camera, context.height, context.tilt,
+                          {verified.pose, verified.refinement.focal_scale}, &jk);
     j.middleRows<2>(2 * k) = matches[k].whitening * jk;
   }
   const Eigen::Matrix4d& c = verified.refinement.covariance;
@@ -134,21 +132,20 @@ Eigen::Matrix4d DoubtedCovariance(const VerificationContext& context,
     pose.x += group.shift(1);
     pose.y += group.shift(2);
     const double scale = verified.refinement.focal_scale + group.shift(3);
-    // The lines and their uncertainty from the pose without the group (a line must not vouch
+    // The lines and their uncertainty from the pose without the group (a line must not confirm
     // for itself); which edges are in view, over which stretch and unhidden, from the pose where
     // the pairs were found (a small shift must not push a seen edge out of the frame).
     ExplainFrom from;
-    from.seen = &verified.pose;
-    from.seen_scale = verified.refinement.focal_scale;
+    from.seen = PoseAndScale{verified.pose, verified.refinement.focal_scale};
     from.beyond_gates = true;  // a gate is a shortcut for search, not a probability of zero
-    // A rival line held by another edge of the interpretation is that pair undone, not free.
-    from.held = &verified.pairs;
-    // Every pair of the group at the pose without all of it: twin false lines on one edge must
-    // not vouch for each other (the chain rule was measured: docs/matching-rounds.md, ninth round).
+    // A rival line another edge of the interpretation explains is that pair undone, not free.
+    from.interpretation = &verified.pairs;
+    // Every pair of the group judged at the pose without all of it (not each at the pose of the
+    // group's other pairs): two false lines on one edge must not confirm each other.
     double log_true = 0.0;
     for (const auto& pair : group.pairs) {
       log_true += LogProbabilityTrue(
-          ExplainPair(context, options, pose, scale, group.covariance, pair, from));
+          ExplainPair(context, options, {pose, scale}, group.covariance, pair, from));
     }
     group.probability_true = std::exp(log_true);
     const double doubt = 1.0 - group.probability_true;

@@ -1,6 +1,6 @@
 // The accepted pose's covariance averaged over what its unreported pairs are (law of total
 // covariance): an unreported pair may be a clutter line that guided matching gave to an edge,
-// and the pose is then the pose of the other pairs (docs/matching-rounds.md, ninth round).
+// and the pose is then the pose of the other pairs (docs/matching.md, section 3).
 #pragma once
 
 #include <utility>
@@ -12,14 +12,14 @@
 
 namespace linetrack {
 
-// The unreported pairs of one model edge, doubted together (twin lines on one edge pin the same
+// The unreported pairs of one model edge, doubted together (two lines on one edge pin the same
 // direction: taken out one at a time, each is replaced by the other).
 struct DoubtedGroup {
   std::vector<std::pair<int, int>> pairs;  // (edge index, line index)
   // Posterior probability that every pair of the group is the edge's image, each from its
   // explanations at the pose without the group: e^l / (e^l + 1 + sum_rivals e^l_r), l its
   // log-likelihood ratio against clutter (prior odds included), the 1 for clutter; a rival line
-  // another edge of the interpretation holds counts e^(l_r - l_holder). Visibility, extent and
+  // another edge of the interpretation explains counts e^(l_r - l_other). Visibility, extent and
   // occlusion are those of the pose itself; ratios also beyond the gates.
   double probability_true = 1.0;
   // The pose without the group (heading, x, y, focal scale) minus the pose, and its covariance.

@@ -6,8 +6,9 @@
 #include <limits>
 #include <set>
 
+#include "matching/edge_candidates.h"
+#include "matching/hypothesis_trimming.h"
 #include "matching/segment_distance.h"
-#include "matching/verification_internal.h"
 #include "models/robot_pose.h"
 
 namespace linetrack {
@@ -47,10 +48,6 @@ struct Assignment {
   double lines_nats = 0.0;
 };
 
-bool Overlap(const LineFit& a, const LineFit& b, double tolerance) {
-  return std::min(a.hi, b.hi) - std::max(a.lo, b.lo) > tolerance;
-}
-
 // Greedy assignment by likelihood ratio: each line to its best edge, unless a better line already
 // covers the same stretch of that edge (fragments of one edge do not overlap). A pair is
 // confident when its ratio exceeds every other explanation of its line (clutter, another edge)
@@ -72,7 +69,7 @@ Assignment Assign(const VerificationContext& context, std::vector<Candidate> can
     const Segment2& piece = (*context.lines)[c.line].pixels;
     const bool blocked = std::any_of(out.assigned.begin(), out.assigned.end(), [&](const auto& a) {
       return a.edge == c.edge &&
-             (Overlap(a.fit, c.fit, overlap_tolerance) ||
+             (SpansOverlap(a.fit, c.fit, overlap_tolerance) ||
               FragmentChiSquare((*context.lines)[a.line].pixels, piece,
                                 context.noise.fragment_offset_px) > options.gate_chi2);
     });
@@ -85,7 +82,7 @@ Assignment Assign(const VerificationContext& context, std::vector<Candidate> can
     double rival = 0.0;  // clutter
     for (const Candidate& c : candidates) {
       if (c.line == a.line && c.edge != a.edge) rival = std::max(rival, c.fit.log_likelihood_ratio);
-      if (c.edge == a.edge && c.line != a.line && Overlap(a.fit, c.fit, overlap_tolerance)) {
+      if (c.edge == a.edge && c.line != a.line && SpansOverlap(a.fit, c.fit, overlap_tolerance)) {
         rival = std::max(rival, c.fit.log_likelihood_ratio);
       }
     }
@@ -175,6 +172,21 @@ LineFitModel FitModel(const VerificationContext& context, const VerificationOpti
   return model;
 }
 
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options) {
+  PoseRefinementOptions refinement = options.refinement;
+  if (context.prior == nullptr) return refinement;
+  const PriorRegion& prior = *context.prior;
+  refinement.bounds.active = true;
+  refinement.bounds.centre = prior.centre;
+  refinement.bounds.radius_m = prior.radius + options.prior_margin_m;
+  refinement.bounds.heading = prior.heading.Mid();
+  refinement.bounds.half_width_rad =
+      0.5 * prior.heading.Width() + DegToRad(options.prior_margin_deg);
+  refinement.bounds.sigmas = options.prior_margin_sigmas;
+  return refinement;
+}
+
 bool VerificationOptions::Check(std::string* why) const {
   if (!(gate_chi2 > 0.0) || !(extent_sigmas > 0.0) || guided_rounds < 1 || min_matches < 2 ||
       max_pair_tests < 1 || !(hypothesis_quantile >= 0.975 && hypothesis_quantile < 1.0) ||
@@ -207,12 +219,6 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
   return result;
 }
 
-bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOptions& options) {
-  const int dof = 2 * static_cast<int>(hypothesis.pairs.size()) - 3;
-  return hypothesis.refinement.chi2 <=
-         ChiSquareQuantile(dof, NormalQuantile(options.hypothesis_quantile));
-}
-
 double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
                           const VerifiedPose& hypothesis) {
   const std::vector<EdgeImage> images = ProjectPairedEdges(
@@ -228,7 +234,7 @@ double HypothesisEvidence(const VerificationContext& context, const Verification
   return total;
 }
 
-std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+std::vector<std::pair<int, int>> ConsensusSet(const VerificationContext& context,
                                               const VerificationOptions& options,
                                               const VerifiedPose& verified) {
   const double sigma_theta = DegToRad(context.noise.angle_deg);
@@ -238,7 +244,7 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
     whitening.push_back(
         Whitening(EndpointNoiseCovariance(-half, half, context.noise.offset_px, sigma_theta)));
   }
-  std::vector<std::pair<int, int>> fitting;
+  std::vector<std::pair<int, int>> consensus;
   const PoseView view = ViewOf(verified.pose, context.height, context.tilt);
   for (size_t e = 0; e < context.edges->size(); ++e) {
     const MatchEdge& edge = (*context.edges)[e];
@@ -249,15 +255,15 @@ std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context
       const Eigen::Vector2d r(image_line.dot(Eigen::Vector3d(s.a.x(), s.a.y(), 1.0)),
                               image_line.dot(Eigen::Vector3d(s.b.x(), s.b.y(), 1.0)));
       if ((whitening[l] * r).squaredNorm() <= options.gate_chi2) {
-        fitting.emplace_back(static_cast<int>(e), static_cast<int>(l));
+        consensus.emplace_back(static_cast<int>(e), static_cast<int>(l));
       }
     }
   }
-  return fitting;
+  return consensus;
 }
 
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
-                     const VerificationOptions& options) {
+                     const VerificationOptions& options, VerificationStats* stats) {
   const LineFitModel model = FitModel(context, options);
   VerifiedPose result = start;
   std::vector<std::pair<int, int>> previous;
@@ -265,16 +271,16 @@ VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& sta
   std::vector<EdgeImage> images;
   for (int round = 0;; ++round) {
     images = ProjectEdges(context, result.pose, result.refinement.focal_scale);
-    assignment = Assign(context,
-                        Candidates(context, images, result.pose, result.refinement.focal_scale,
-                                   result.refinement.covariance, model),
-                        options);
+    CandidateQuery query;
+    query.at = {result.pose, result.refinement.focal_scale};
+    query.covariance = result.refinement.covariance;
+    assignment = Assign(context, Candidates(context, images, model, query, stats), options);
     std::vector<std::pair<int, int>> pairs = Pairs(assignment);
     std::sort(pairs.begin(), pairs.end());
     if (pairs == previous || round == options.guided_rounds || pairs.size() < 2) break;
-    result.refinement =
-        RefinePose(ToLineMatches(context, pairs), *context.camera, context.height, context.tilt,
-                   result.pose, result.refinement.focal_scale, RefinementOptions(context, options));
+    result.refinement = RefinePose(ToLineMatches(context, pairs), *context.camera, context.height,
+                                   context.tilt, {result.pose, result.refinement.focal_scale},
+                                   RefinementOptions(context, options));
     result.pose = result.refinement.pose;
     previous = std::move(pairs);
   }
@@ -354,133 +360,6 @@ void CompleteEvidence(const VerificationContext& context, const VerificationOpti
     evidence.edges_nats += fraction * log_detected + (1.0 - fraction) * log_missed;
   }
   verified->evidence_complete = true;
-}
-
-double RequiredEvidence(const VerificationContext& context, const VerificationOptions& options,
-                        const VerifiedPose& verified) {
-  if (context.prior == nullptr) return options.chance_nats;
-  const PriorRegion& prior = *context.prior;
-  const double prior_volume = kPi * std::max(prior.radius, 0.01) * std::max(prior.radius, 0.01) *
-                              std::max(prior.heading.Width(), DegToRad(0.1));
-  const double det = verified.refinement.covariance.topLeftCorner<3, 3>().determinant();
-  if (!(det > 0.0) || !std::isfinite(det)) return std::numeric_limits<double>::infinity();
-  const double pose_volume = std::pow(2.0 * kPi, 1.5) * std::sqrt(det);
-  return options.chance_nats + std::max(0.0, std::log(prior_volume / pose_volume));
-}
-
-PairExplanations ExplainPair(const VerificationContext& context, const VerificationOptions& options,
-                             const Pose3Dof& pose, double scale, const Eigen::Matrix4d& covariance,
-                             const std::pair<int, int>& pair, const ExplainFrom& from) {
-  const auto [edge, line] = pair;
-  VerificationContext uncounted = context;  // not part of the search's work budget
-  uncounted.pair_tests = nullptr;
-  const std::vector<EdgeImage> images =
-      from.seen != nullptr ? ProjectEdgesSeenFrom(context, pose, scale, *from.seen, from.seen_scale)
-                           : ProjectEdges(context, pose, scale);
-  const std::vector<Candidate> fits =
-      Candidates(uncounted, images, pose, scale, covariance, FitModel(context, options), true,
-                 from.seen, from.seen_scale);
-  PairExplanations out;
-  auto fit_of = [&](int e, int l) {
-    return std::find_if(fits.begin(), fits.end(),
-                        [&](const Candidate& c) { return c.edge == e && c.line == l; });
-  };
-  const auto found = fit_of(edge, line);
-  const Candidate* own = found != fits.end() ? &*found : nullptr;
-  std::vector<Candidate> beyond;
-  if (own == nullptr && from.beyond_gates) {
-    // Its ratio all the same (the gates only save work): the line alone against every edge.
-    LineFitModel ungated = FitModel(context, options);
-    ungated.gate_chi2 = ungated.extent_sigmas = std::numeric_limits<double>::infinity();
-    const std::vector<ObservedLine> alone = {(*context.lines)[line]};
-    VerificationContext single = uncounted;
-    single.lines = &alone;
-    single.excluded_pair = {-1, -1};
-    for (Candidate& c : Candidates(single, images, pose, scale, covariance, ungated, true,
-                                   from.seen, from.seen_scale)) {
-      if (c.edge != edge) continue;
-      c.line = line;  // its index among all lines
-      beyond.push_back(c);
-    }
-    if (!beyond.empty()) own = &beyond.front();
-  }
-  if (own == nullptr) return out;  // not in view, or hidden, at that pose
-  out.own = own->fit.log_likelihood_ratio;
-  const double overlap_tolerance = 3.0 * context.noise.offset_px;
-  // Two lines can both be images of one edge: fragments that do not overlap, on one line.
-  auto fragments_of_one = [&](const Candidate& a, const Candidate& b) {
-    const Segment2& pa = (*context.lines)[a.line].pixels;
-    const Segment2& pb = (*context.lines)[b.line].pixels;
-    const bool longer = pa.Length() > pb.Length();
-    return !Overlap(a.fit, b.fit, overlap_tolerance) &&
-           FragmentChiSquare(longer ? pa : pb, longer ? pb : pa,
-                             context.noise.fragment_offset_px) <= options.gate_chi2;
-  };
-  for (const Candidate& c : fits) {
-    if (c.line == line && c.edge != edge) {
-      out.rivals.push_back(c.fit.log_likelihood_ratio);
-    }
-    if (c.edge != edge || c.line == line) continue;
-    if (fragments_of_one(*own, c)) {
-      out.fragments = out.fragments || c.fit.log_likelihood_ratio > 0.0;
-    } else {
-      double displaced = 0.0;  // the ratio of the pair that holds the rival line, if any
-      if (from.held != nullptr) {
-        for (const auto& [e, l] : *from.held) {
-          if (l != c.line || e == edge) continue;
-          const auto holder = fit_of(e, l);
-          if (holder != fits.end()) displaced += holder->fit.log_likelihood_ratio;
-        }
-      }
-      out.rivals.push_back(c.fit.log_likelihood_ratio - displaced);
-    }
-  }
-  return out;
-}
-
-std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
-                                                        const VerificationOptions& options,
-                                                        const VerifiedPose& verified) {
-  std::vector<std::pair<int, int>> reported;
-  for (size_t i = 0; i < verified.pairs.size(); ++i) {
-    if (!std::binary_search(verified.confident_pairs.begin(), verified.confident_pairs.end(),
-                            verified.pairs[i])) {
-      continue;
-    }
-    // The pose of the other pairs: the pair's line must not vouch for itself. When the pair
-    // alone fixes a direction of the pose, its own pose is all there is.
-    Pose3Dof pose;
-    Eigen::Matrix4d covariance;
-    if (!DeletedPose(context, verified, i, &pose, &covariance)) {
-      pose = verified.pose;
-      covariance = verified.refinement.covariance;
-    }
-    const PairExplanations explained = ExplainPair(
-        context, options, pose, verified.refinement.focal_scale, covariance, verified.pairs[i]);
-    // Outside the gates at the pose of the others, or not likelier than clutter there.
-    if (!(explained.own > 0.0)) continue;
-    // Other explanations at that pose: another edge for the line; another line for the edge
-    // that would be its image instead (over the same stretch, or off the line of this one); and,
-    // when the edge has other lines there (this one would be a further fragment beside them),
-    // clutter: the line must stand without pulling the pose toward itself.
-    double rival = explained.fragments ? 0.0 : -std::numeric_limits<double>::infinity();
-    for (const double r : explained.rivals) {
-      if (r > 0.0) rival = std::max(rival, r);  // the rivals likelier than clutter
-    }
-    if (explained.own - rival >= options.report_nats) reported.push_back(verified.pairs[i]);
-  }
-  std::sort(reported.begin(), reported.end());
-  return reported;
-}
-
-bool BetterThan(const VerifiedPose& a, const VerifiedPose& b) {
-  if (a.plausible != b.plausible) return a.plausible;
-  return a.evidence.Score() > b.evidence.Score();
-}
-
-bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options) {
-  return std::hypot(a.x - b.x, a.y - b.y) <= options.same_pose_m &&
-         std::abs(WrapAngle(a.heading - b.heading)) <= DegToRad(options.same_pose_deg);
 }
 
 bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b) {

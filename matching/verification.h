@@ -5,11 +5,7 @@
 // result scored as a log-likelihood ratio against "every line is clutter" (docs/matching.md).
 #pragma once
 
-#include <array>
-#include <cstdint>
-#include <map>
 #include <string>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -29,7 +25,7 @@ struct VerificationOptions {
   double gate_chi2 = 13.8;
   double extent_sigmas = 3.0;
   int guided_rounds = 3;  // assignment + re-estimation rounds (fewer when it stops changing)
-  // A hypothesis whose own pairs have a chi-square beyond this quantile of chi2(2n - 4) at its
+  // A hypothesis whose own pairs have a chi-square beyond this quantile of chi2(2n - 3) at its
   // pose is inconsistent: rejected before guided matching (the early-out for hopeless ones).
   double hypothesis_quantile = 0.999;
   // An inconsistent hypothesis is restarted from the largest subset of its pairs that agrees
@@ -55,13 +51,12 @@ struct VerificationOptions {
   double same_pose_deg = 5.0;
   // The tree does not explore again regions within this many standard deviations of a
   // verified plausible pose.
-  double basin_sigmas = 3.0;
+  double neighbourhood_sigmas = 3.0;
   // Bound of the tree search: a line is counted for this share of its cap
-  // (MaxLogLikelihoodRatio). Not a strict bound: on 300 synthetic scenes of seed 7 (not a
-  // benchmark seed) the accepted true poses reached 0.655 of their lines' caps in the median,
-  // 0.847 at the 99th percentile, 0.891 at most; 0.7 cuts the subtrees that could only win with
-  // better-than-typical lines, and the truth, searched first by iterative deepening, is rarely
-  // one of them (docs/matching-rounds.md, third round).
+  // (MaxLogLikelihoodRatio). Not a strict bound but a typical share: true poses reach about two
+  // thirds of their lines' caps (docs/matching.md, section 2), so 0.7 cuts the subtrees that
+  // could only win with better-than-typical lines, and the truth, searched first by iterative
+  // deepening, is rarely one of them.
   double cap_efficiency = 0.7;
   // Work budget of the verification (deterministic): (line, visible edge) pairs guided matching
   // may test over all hypotheses of one localisation; then no more hypotheses are verified.
@@ -71,8 +66,7 @@ struct VerificationOptions {
   double max_heading_sigma_deg = 5.0;
   // The accepted pose's covariance does not lean on an unreported pair whose leverage (largest
   // eigenvalue of J_i C J_i') reaches this: without it a variance of the pose grows by at least
-  // 1 / (1 - leverage), 4 times at 0.75 (VouchedRefinement, docs/matching-rounds.md, seventh
-  // round).
+  // 1 / (1 - leverage), 4 times at 0.75 (LowLeverageRefinement, pose_decision.h).
   double max_unreported_leverage = 0.75;
   // The accepted pose's covariance then also averages over what its unreported pairs are: each
   // edge's unreported pairs are false with their posterior probability, and the pose is then
@@ -95,30 +89,6 @@ struct VerificationOptions {
   bool Check(std::string* why) const;
 };
 
-// The consensus restart's minimal poses of two pairs and the whitened chi-square of a third pair
-// at each, and the trimming's refits, memoised over the hypotheses of one localisation (sibling
-// leaves of the tree share most of their pairs). Keys are (edge index, line index) pairs; values
-// are exactly those computed without the memo.
-struct ConsensusMemo {
-  struct Entry {
-    std::vector<Pose3Dof> poses;
-    std::vector<std::unordered_map<uint64_t, double>> chi2;  // per pose, by PairKey of the third
-  };
-  struct Hash {
-    size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
-      return std::hash<uint64_t>()(k.first * 0x9E3779B97F4A7C15ULL ^ k.second);
-    }
-  };
-  static uint64_t PairKey(const std::pair<int, int>& pair) {
-    return (static_cast<uint64_t>(static_cast<uint32_t>(pair.first)) << 32) |
-           static_cast<uint32_t>(pair.second);
-  }
-  std::unordered_map<std::pair<uint64_t, uint64_t>, Entry, Hash> entries;
-  // Levenberg-Marquardt refits of the trimming: by (pairs, start x, y, heading, focal scale).
-  using RefitKey = std::pair<std::vector<std::pair<int, int>>, std::array<double, 4>>;
-  std::map<RefitKey, PoseRefinementResult> refits;
-};
-
 // What a localisation problem looks like to the verifier.
 struct VerificationContext {
   const std::vector<MatchEdge>* edges = nullptr;  // candidate edges
@@ -133,12 +103,14 @@ struct VerificationContext {
   const PriorRegion* prior = nullptr;
   const NavigableArea* area = nullptr;
   LineNoise noise;  // line noise and calibration error (focal_relative)
-  // When set, counts the (line, visible edge) pairs guided matching tests (the work budget).
-  long* pair_tests = nullptr;
   // When set, a pair (edge index, line index) guided matching may not use (a rival without it).
   std::pair<int, int> excluded_pair = {-1, -1};
-  // When set, TrimHypothesis' consensus restart reads and fills this memo.
-  ConsensusMemo* consensus_memo = nullptr;
+};
+
+// The work of the verification, for the localizer's deterministic budget: the (line, visible
+// edge) pairs guided matching tested.
+struct VerificationStats {
+  long pair_tests = 0;
 };
 
 // Evidence for a pose (nats): the log-likelihood ratio of the observed lines under "the camera is
@@ -175,6 +147,16 @@ struct VerifiedPose {
 // The line-fit model of the verification (noise of the context, gates of the options).
 LineFitModel FitModel(const VerificationContext& context, const VerificationOptions& options);
 
+// Pairs as LineMatches whitened by the noise model with levers from the segment's own middle
+// (the projection is not known yet).
+std::vector<LineMatch> ToLineMatches(const VerificationContext& context,
+                                     const std::vector<std::pair<int, int>>& pairs);
+
+// The verification's refinement options with the prior as bounds (PoseBounds): the prior disk
+// and heading interval widened by the options' margins, as the plausibility check widens them.
+PoseRefinementOptions RefinementOptions(const VerificationContext& context,
+                                        const VerificationOptions& options);
+
 // The pose of a hypothesis (pairs of edge/line indices) by Levenberg-Marquardt from each of the
 // `starts`, the lowest cost kept; not yet re-matched nor scored.
 VerifiedPose RefineHypothesis(const VerificationContext& context,
@@ -182,86 +164,27 @@ VerifiedPose RefineHypothesis(const VerificationContext& context,
                               const std::vector<Pose3Dof>& starts,
                               const VerificationOptions& options);
 
-// True when the hypothesis' own pairs fit its pose within the noise model (chi-square test).
-bool ConsistentHypothesis(const VerifiedPose& hypothesis, const VerificationOptions& options);
-
-// Makes a refined hypothesis consistent (the interpretation tree's gates are looser than the
-// chi-square test, so a leaf may hold wrong pairs beside true ones): when it is not, restarts
-// from the largest subset of its pairs agreeing with a minimal pose of two of them, then drops
-// the pair with the largest whitened residual and refines again while still inconsistent; then
-// drops the outlying pair (OutlyingPair) while there is one. False when fewer than three pairs
-// would be left.
-bool TrimHypothesis(const VerificationContext& context, const VerificationOptions& options,
-                    VerifiedPose* hypothesis);
-
 // The most evidence (nats) a refined hypothesis' own pairs give at its pose: their
 // log-likelihood ratios with no pose uncertainty (guided matching then moves the pose little and
 // a maximal leaf leaves few lines to add). A cheap early-out before guided matching.
 double HypothesisEvidence(const VerificationContext& context, const VerificationOptions& options,
                           const VerifiedPose& hypothesis);
 
-// Every (edge index, line index) pair that fits the verified pose: whitened endpoint residuals
-// at its pose and focal scale within gate_chi2 (sorted). A hypothesis most of whose pairs fit a
-// verified pose would be verified into it again.
-std::vector<std::pair<int, int>> FittingPairs(const VerificationContext& context,
+// The consensus set of a verified pose: every (edge index, line index) pair whose whitened
+// endpoint residuals at its pose and focal scale are within gate_chi2 (sorted). A hypothesis most
+// of whose pairs are in it would be verified into that pose again.
+std::vector<std::pair<int, int>> ConsensusSet(const VerificationContext& context,
                                               const VerificationOptions& options,
                                               const VerifiedPose& verified);
 
 // Guided matching from `start` (options.guided_rounds rounds of assignment and re-estimation),
-// then the plausibility checks and the lines term of the evidence.
+// then the plausibility checks and the lines term of the evidence. `stats`, when given, counts
+// the pairs tested.
 VerifiedPose Rematch(const VerificationContext& context, const VerifiedPose& start,
-                     const VerificationOptions& options);
+                     const VerificationOptions& options, VerificationStats* stats = nullptr);
 
-// The pair of a refined hypothesis that least fits the pose of the others: the largest
-// deleted-residual chi-square r' (I - H)^-1 r (r its whitened endpoint residuals, H = W J C J' W'
-// its leverage block; chi2(2) when the pair is true), when above gate_chi2; -1 when none is.
-int OutlyingPair(const VerificationContext& context, const VerificationOptions& options,
-                 const VerifiedPose& hypothesis);
-
-// The pose a refined hypothesis' pairs give without pair i, to first order: pose + C J_i'
-// (I - H_ii)^-1 r_i (whitened residuals r_i, Jacobian J_i, leverage H_ii = J_i C J_i'), and
-// when `covariance` is given its covariance C + C J_i' (I - H_ii)^-1 J_i C (heading, x, y,
-// scale). False (pose unchanged) when pair i alone fixes a direction of the pose (H_ii near the
-// identity).
-bool DeletedPose(const VerificationContext& context, const VerifiedPose& verified, size_t i,
-                 Pose3Dof* pose, Eigen::Matrix4d* covariance = nullptr);
-
-// The reported correspondences of a verified pose: those of its confident_pairs that, at the
-// pose of its other pairs (DeletedPose, with that pose's covariance), are within the gates and
-// beat by report_nats every other edge for the line and every rival line for the edge: another
-// line that fits the edge there and cannot be the same image (it overlaps the pair's line along
-// the edge, or the two are not collinear fragments), e.g. a door casing's border or a box's
-// bottom beside the edge. When the edge has other lines there that are fragments of the same
-// image, the pair's line must also beat clutter at that pose: a further fragment beside them
-// must stand without pulling the pose toward itself (docs/matching.md, section 7).
-std::vector<std::pair<int, int>> PairsBeatingRivalLines(const VerificationContext& context,
-                                                        const VerificationOptions& options,
-                                                        const VerifiedPose& verified);
-
-// The refinement of a verified pose over the pairs it can lean on: `reported` (its reported
-// correspondences) and those of its other pairs whose leverage at its pose (largest eigenvalue of
-// W J_i C J_i' W') is below options.max_unreported_leverage, refitted from its pose (all the
-// high-leverage unreported pairs left out at once); its own refinement when none is left out. An
-// unreported pair that alone fixes a direction of the pose cannot be tested (OutlyingPair) and is
-// not vouched for: the precision it gives is not the answer's (seed 2 QI1 scene 107). `kept`,
-// when given, receives the pairs of the refinement.
-PoseRefinementResult VouchedRefinement(const VerificationContext& context,
-                                       const VerificationOptions& options,
-                                       const VerifiedPose& verified,
-                                       const std::vector<std::pair<int, int>>& reported,
-                                       std::vector<std::pair<int, int>>* kept = nullptr);
-
-// The poses a verified pose's pairs give without one of its influential pairs (the first-order
-// deleted pose distinct from it, or beyond its uncertainty: Cook's distance above the
-// hypothesis_quantile of chi2(3)), each refined and verified by Rematch without that pair
-// (evidence lines term only). A pose that hinges on one correspondence has the pose of the
-// others as a rival explanation, which the tree does not verify (a subset of a verified leaf).
-std::vector<VerifiedPose> LeaveOneOutRivals(const VerificationContext& context,
-                                            const VerificationOptions& options,
-                                            const VerifiedPose& verified);
-
-// RefineHypothesis, TrimHypothesis, then Rematch (a hypothesis that cannot be made consistent is
-// returned implausible without guided matching).
+// RefineHypothesis, TrimHypothesis (hypothesis_trimming.h), then Rematch (a hypothesis that cannot
+// be made consistent is returned implausible without guided matching).
 VerifiedPose VerifyHypothesis(const VerificationContext& context,
                               const std::vector<std::pair<int, int>>& pairs,
                               const std::vector<Pose3Dof>& starts,
@@ -271,23 +194,11 @@ VerifiedPose VerifyHypothesis(const VerificationContext& context,
 void CompleteEvidence(const VerificationContext& context, const VerificationOptions& options,
                       VerifiedPose* verified);
 
-// The evidence (nats) a verified pose needs not to be a chance alignment: chance_nats plus
-// ln(V_prior / V_pose), V_prior = pi delta_t^2 2 delta_phi the prior's volume in (x, y, heading)
-// and V_pose = (2 pi)^(3/2) sqrt(det C) the pose's (C its covariance): the number of distinct
-// poses the search could have found by chance.
-double RequiredEvidence(const VerificationContext& context, const VerificationOptions& options,
-                        const VerifiedPose& verified);
-
-// Orders verified poses: plausible first, then the larger evidence.
-bool BetterThan(const VerifiedPose& a, const VerifiedPose& b);
-
-// True when two poses are the same answer (within same_pose_m and same_pose_deg).
-bool SamePose(const Pose3Dof& a, const Pose3Dof& b, const VerificationOptions& options);
-
 // True when two refined hypotheses of the same pairs are one pose: positions within 1 cm,
 // headings within 0.1 degree and focal scales within 0.1 % (a hundred times the verification's
-// Levenberg-Marquardt step tolerance, far below the poses' noise of about 7 cm and 0.3 degree).
-// Guided matching from either gives the same verified pose (the localizer verifies it once).
+// Levenberg-Marquardt step tolerance, far below the poses' noise of centimetres and tenths of a
+// degree). Guided matching from either gives the same verified pose (the localizer verifies it
+// once).
 bool SameRefinedPose(const Pose3Dof& a, double scale_a, const Pose3Dof& b, double scale_b);
 
 }  // namespace linetrack

@@ -12,9 +12,7 @@
 #include "models/errors.h"
 
 namespace linetrack {
-namespace {
-
-std::string ReadText(const std::string& path) {
+std::string ReadCameraText(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(Located(path, 0, "no such camera file"));
   std::ifstream in(path);
@@ -25,6 +23,8 @@ std::string ReadText(const std::string& path) {
   }
   return text.str();
 }
+
+namespace {
 
 // Text of the first <tag>...</tag> inside `xml` (trimmed), or nullopt.
 std::optional<std::string> FirstElement(const std::string& xml, const std::string& tag) {
@@ -123,7 +123,7 @@ Eigen::Vector2d CameraIntrinsics::Undistort(const Eigen::Vector2d& uv) const {
 
 CameraIntrinsics ReadCameraXml(const std::string& path, const std::string& name, int width,
                                int height) {
-  const std::string xml = ReadText(path);
+  const std::string xml = ReadCameraText(path);
   CameraIntrinsics cam;
   if (xml.find("<camera>") == std::string::npos) {
     throw InputError(Located(path, 0, "not a ViSP camera file: no <camera> element"));

@@ -46,7 +46,11 @@ struct CameraIntrinsics {
   }
 };
 
-// Reads a camera from a ViSP camera XML file (vpXmlParserCamera). The model with distortion is
+// The text of a camera file. Throws InputError naming the file when it is missing or unreadable.
+std::string ReadCameraText(const std::string& path);
+
+// Reads a camera from a ViSP camera XML file (vpXmlParserCamera); ReadCamera
+// (models/camera_file.h) reads OpenCV and ROS files too. The model with distortion is
 // taken when the file has one, else the model without. `name` empty: the first camera.
 // `width`/`height` 0: any size. Throws InputError naming the file and what is missing.
 CameraIntrinsics ReadCameraXml(const std::string& path, const std::string& name = "", int width = 0,

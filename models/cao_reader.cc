@@ -23,7 +23,8 @@ struct Line {
 };
 
 // Splits text into non-empty lines of whitespace-separated tokens, comments ('#' to the end of
-// the line) and carriage returns removed.
+// the line) and carriage returns removed. A quoted parameter value (name="north door") stays one
+// token.
 std::vector<Line> Tokenize(const std::string& text) {
   std::vector<Line> lines;
   std::istringstream in(text);
@@ -39,8 +40,15 @@ std::vector<Line> Tokenize(const std::string& text) {
     std::istringstream words(raw);
     Line line{number, {}};
     std::string token;
-    while (words >> token)
+    while (words >> token) {
+      const size_t quote = token.find("=\"");
+      std::string more;  // the rest of a quoted value, up to its closing quote
+      while (quote != std::string::npos && (token.size() == quote + 2 || token.back() != '"') &&
+             words >> more) {
+        token += " " + more;
+      }
       line.tokens.push_back(token);
+    }
     if (!line.tokens.empty()) lines.push_back(std::move(line));
   }
   return lines;
@@ -68,6 +76,19 @@ bool ParseIndex(const std::string& s, long* out) {
 // Parameters ViSP allows after an element, e.g. name="door" useLod=true.
 bool IsParameter(const std::string& token) {
   return token.find('=') != std::string::npos;
+}
+
+// The value of the name="..." (or name=...) parameter among tokens[from...]; "" without one.
+std::string NameParameter(const std::vector<std::string>& tokens, size_t from) {
+  for (size_t i = from; i < tokens.size(); ++i) {
+    if (tokens[i].rfind("name=", 0) != 0) continue;
+    std::string value = tokens[i].substr(5);
+    if (value.size() >= 2 && value.front() == '"' && value.back() == '"') {
+      value = value.substr(1, value.size() - 2);
+    }
+    return value;
+  }
+  return "";
 }
 
 std::string ParentDirectory(const std::string& path) {
@@ -147,11 +168,11 @@ class Parser {
     Eigen::Isometry3d file_from_include = Eigen::Isometry3d::Identity();
     const std::string params = joined.substr(q2 + 1);
     Eigen::Vector3d t;
-    if (ReadVectorParam(params, "t=[", line.number, &t, false)) {
+    if (ReadVectorParam(params, "t=[", line.number, &t, /*angles=*/false)) {
       file_from_include.translation() = t;
     }
     Eigen::Vector3d tu;
-    if (ReadVectorParam(params, "tu=[", line.number, &tu, true) && tu.norm() > 0.0) {
+    if (ReadVectorParam(params, "tu=[", line.number, &tu, /*angles=*/true) && tu.norm() > 0.0) {
       file_from_include.linear() = Eigen::AngleAxisd(tu.norm(), tu.normalized()).toRotationMatrix();
     }
     if (!read_include_) Fail(line.number, "includes are not allowed here");
@@ -266,6 +287,7 @@ class Parser {
       CheckOnlyParameters(line, 2, what);
       file_lines_.push_back({base + a, base + b});
       model_->lines.push_back({base + a, base + b});
+      model_->line_names.push_back(NameParameter(line.tokens, 2));
     }
   }
 
@@ -285,6 +307,7 @@ class Parser {
       }
       CheckOnlyParameters(line, 1 + n, what);
       model_->faces.push_back(ChainLines(edges, line.number, what));
+      model_->face_names.push_back(NameParameter(line.tokens, 1 + n));
     }
   }
 
@@ -323,6 +346,7 @@ class Parser {
         face.push_back(base + ReadIndex(line, 1 + i, num_points, what));
       CheckOnlyParameters(line, 1 + n, what);
       model_->faces.push_back(std::move(face));
+      model_->face_names.push_back(NameParameter(line.tokens, 1 + n));
     }
   }
 

@@ -18,8 +18,10 @@ struct CaoModel {
   std::vector<Eigen::Vector3d> points;    // metres, in the model (world) frame
   std::vector<std::array<int, 2>> lines;  // indices into points
   std::vector<std::vector<int>> faces;    // closed polygons as indices into points
-  std::vector<std::string> warnings;      // e.g. cylinders and circles ignored
-  std::vector<std::string> files;         // every file read, the top one first
+  // The name="..." parameter of each line and face (parallel to lines and faces; "" without).
+  std::vector<std::string> line_names, face_names;
+  std::vector<std::string> warnings;  // e.g. cylinders and circles ignored
+  std::vector<std::string> files;     // every file read, the top one first
 };
 
 // Reads the content of an included file: returns nullopt when it cannot be read.

@@ -35,11 +35,15 @@ class PointSnapper {
   }
 
  private:
-  static long long Key(long long x, long long y) { return x * 73856093LL ^ y * 19349663LL; }
+  // Spatial hash of a cell (Teschner et al. 2003); unsigned so that far cells wrap, not overflow.
+  static unsigned long long Key(long long x, long long y) {
+    return static_cast<unsigned long long>(x) * 73856093ULL ^
+           static_cast<unsigned long long>(y) * 19349663ULL;
+  }
   double radius_;
   double cell_;
   std::vector<Eigen::Vector2d>* points_;
-  std::unordered_map<long long, std::vector<int>> grid_;
+  std::unordered_map<unsigned long long, std::vector<int>> grid_;
 };
 
 int Find(std::vector<int>& parent, int x) {
@@ -48,13 +52,72 @@ int Find(std::vector<int>& parent, int x) {
   return x;
 }
 
-// Parameters (0..1 along wall i) where the other walls cross, touch or overlap it.
+// The walls in a uniform grid of their bounding boxes: the candidates that can meet a wall.
+class WallGrid {
+ public:
+  WallGrid(const std::vector<PlanWall>& walls, double tolerance) : tolerance_(tolerance) {
+    if (walls.empty()) return;
+    Eigen::Vector2d lo = walls.front().segment.a, hi = lo;
+    double total = 0.0;
+    for (const PlanWall& w : walls) {
+      lo = lo.cwiseMin(w.segment.a).cwiseMin(w.segment.b);
+      hi = hi.cwiseMax(w.segment.a).cwiseMax(w.segment.b);
+      total += w.segment.Length();
+    }
+    origin_ = lo;
+    // About as many cells as walls, no smaller than the mean wall.
+    const Eigen::Vector2d extent = (hi - lo).cwiseMax(Eigen::Vector2d::Constant(1e-9));
+    cell_ =
+        std::max({total / walls.size(), std::sqrt(extent.x() * extent.y() / walls.size()), 1e-6});
+    cols_ = static_cast<int>(extent.x() / cell_) + 1;
+    rows_ = static_cast<int>(extent.y() / cell_) + 1;
+    cells_.assign(static_cast<size_t>(cols_) * rows_, {});
+    for (size_t i = 0; i < walls.size(); ++i) {
+      ForCells(walls[i].segment, [&](size_t c) { cells_[c].push_back(static_cast<int>(i)); });
+    }
+  }
+
+  // Walls whose cells meet those of `s` (sorted, each once).
+  std::vector<int> Near(const Segment2& s) const {
+    std::vector<int> out;
+    ForCells(s, [&](size_t c) { out.insert(out.end(), cells_[c].begin(), cells_[c].end()); });
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+ private:
+  template <typename Visit>
+  void ForCells(const Segment2& s, const Visit& visit) const {
+    const Eigen::Vector2d lo = s.a.cwiseMin(s.b).array() - tolerance_;
+    const Eigen::Vector2d hi = s.a.cwiseMax(s.b).array() + tolerance_;
+    auto col = [&](double x) {
+      return std::clamp(static_cast<int>(std::floor((x - origin_.x()) / cell_)), 0, cols_ - 1);
+    };
+    auto row = [&](double y) {
+      return std::clamp(static_cast<int>(std::floor((y - origin_.y()) / cell_)), 0, rows_ - 1);
+    };
+    for (int r = row(lo.y()); r <= row(hi.y()); ++r) {
+      for (int c = col(lo.x()); c <= col(hi.x()); ++c)
+        visit(static_cast<size_t>(r) * cols_ + c);
+    }
+  }
+
+  double tolerance_;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  double cell_ = 1.0;
+  int cols_ = 0, rows_ = 0;
+  std::vector<std::vector<int>> cells_;
+};
+
+// Parameters (0..1 along wall i) where the walls `near` cross, touch or overlap it.
 std::vector<double> SplitParameters(const std::vector<PlanWall>& walls, size_t i,
-                                    double tolerance) {
+                                    const std::vector<int>& near, double tolerance) {
   const Eigen::Vector2d a = walls[i].segment.a, d = walls[i].segment.b - a;
   const double len = d.norm();
   std::vector<double> params = {0.0, 1.0};
-  for (size_t j = 0; j < walls.size(); ++j) {
+  for (int near_j : near) {
+    const size_t j = static_cast<size_t>(near_j);
     const Eigen::Vector2d aj = walls[j].segment.a, dj = walls[j].segment.b - aj;
     const double lenj = dj.norm();
     if (j == i || lenj <= tolerance) continue;
@@ -84,11 +147,12 @@ PlanArrangement PlanArrangement::Build(const std::vector<PlanWall>& walls, doubl
   arr.tolerance_ = tolerance;
   PointSnapper snapper(2.0 * tolerance, &arr.vertices_);
   std::map<std::pair<int, int>, int> edge_of;
+  const WallGrid grid(walls, tolerance);
   for (size_t i = 0; i < walls.size(); ++i) {
     const Segment2& s = walls[i].segment;
     if (s.Length() <= tolerance) continue;
     int previous = -1;
-    for (double t : SplitParameters(walls, i, tolerance)) {
+    for (double t : SplitParameters(walls, i, grid.Near(s), tolerance)) {
       const Eigen::Vector2d p = t == 0.0   ? s.a
                                 : t == 1.0 ? s.b
                                            : Eigen::Vector2d(s.a + t * (s.b - s.a));

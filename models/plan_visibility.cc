@@ -92,22 +92,33 @@ std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double 
 
 std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
                                           double camera_top) {
-  const double z_lo = model.BoxMin().z() + tolerance;
-  const double z_hi = std::max(model.BoxMax().z(), camera_top) - tolerance;
+  return OccludersInBand(model, model.BoxMin().z() + tolerance,
+                         std::max(model.BoxMax().z(), camera_top) - tolerance);
+}
+
+WallInPlane ToWallPlane(const ModelFace& face) {
+  WallInPlane wall;
+  const Eigen::Vector2d n = face.normal.head<2>().normalized();
+  wall.along = Eigen::Vector2d(-n.y(), n.x());
+  wall.origin = face.corners.front().head<2>();
+  wall.z_lo = std::numeric_limits<double>::infinity();
+  wall.z_hi = -wall.z_lo;
+  for (const Eigen::Vector3d& c : face.corners) {
+    wall.s_z.emplace_back(wall.along.dot(c.head<2>() - wall.origin), c.z());
+    wall.z_lo = std::min(wall.z_lo, c.z());
+    wall.z_hi = std::max(wall.z_hi, c.z());
+  }
+  return wall;
+}
+
+std::vector<Segment2> OccludersInBand(const WireframeModel& model, double z_lo, double z_hi) {
   std::vector<Segment2> pieces;
   if (!(z_hi > z_lo)) return pieces;
   for (const ModelFace& face : model.faces()) {
     if (!face.vertical || face.Degenerate()) continue;
-    const Eigen::Vector2d n = face.normal.head<2>().normalized();
-    const Eigen::Vector2d along(-n.y(), n.x());
-    const Eigen::Vector2d origin = face.corners.front().head<2>();
-    Ring2 s_z;
-    for (const Eigen::Vector3d& c : face.corners) {
-      s_z.emplace_back(along.dot(c.head<2>() - origin), c.z());
-    }
-    for (const auto& [s0, s1] : FullHeightSpans(s_z, z_lo, z_hi)) {
-      pieces.push_back({origin + s0 * along, origin + s1 * along});
-    }
+    const WallInPlane wall = ToWallPlane(face);
+    for (const auto& [s0, s1] : FullHeightSpans(wall.s_z, z_lo, z_hi))
+      pieces.push_back({wall.At(s0), wall.At(s1)});
   }
   return MergeCollinear(pieces, 1e-6);
 }
@@ -259,7 +270,7 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
       if (v.norm() <= kTouch) return range;
-      const double a = WrapAngle(std::atan2(v.y(), v.x()) - reference);
+      const double a = std::atan2(Cross2(centre, v), centre.dot(v));  // from the centre, no wrap
       lo = std::min(lo, a);
       hi = std::max(hi, a);
     }

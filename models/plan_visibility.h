@@ -20,6 +20,21 @@ namespace linetrack {
 std::vector<Segment2> FullHeightOccluders(const WireframeModel& model, double tolerance,
                                           double camera_top);
 
+// Floor-plan segments of the parts of the vertical faces that cover [z_lo, z_hi] (one storey's
+// band of camera heights), collinear touching pieces merged.
+std::vector<Segment2> OccludersInBand(const WireframeModel& model, double z_lo, double z_hi);
+
+// A vertical face in its own plane: s metres along `along` from `origin` (floor plan), z up;
+// `along` is the plan normal turned a quarter left.
+struct WallInPlane {
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero(), along = Eigen::Vector2d::UnitX();
+  Ring2 s_z;  // the face's corners as (s, z)
+  double z_lo = 0.0, z_hi = 0.0;
+  Eigen::Vector2d At(double s) const { return origin + s * along; }
+};
+// The (s, z) polygon of a vertical, non-degenerate face.
+WallInPlane ToWallPlane(const ModelFace& face);
+
 // Intervals of s where the polygon `s_z` (points (s, z)) covers the whole band [z_lo, z_hi].
 std::vector<std::pair<double, double>> FullHeightSpans(const Ring2& s_z, double z_lo, double z_hi);
 

@@ -1,4 +1,4 @@
-// Robot camera poses in the project's conventions (docs/conventions.md, shared method.md):
+// Robot camera poses in the project's conventions (docs/conventions.md):
 // world z up, heading counter-clockwise from +x, tilt positive looking down, ViSP camera axes
 // (x right, y down, z forward), roll zero.
 #pragma once

@@ -14,7 +14,29 @@ namespace {
 
 constexpr double kUnitQuaternionTol = 1e-3;
 
-std::string ReadWholeFile(const std::string& path, const std::string& what) {
+// Strips a trailing '\r' and surrounding blanks.
+std::string Trimmed(std::string line) {
+  const size_t first = line.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return "";
+  const size_t last = line.find_last_not_of(" \t\r");
+  return line.substr(first, last - first + 1);
+}
+
+void CheckIncreasing(double t, bool first, double previous, const std::string& path, int line_no) {
+  if (!first && !(t > previous)) {
+    throw InputError(Located(path, line_no, "time does not increase"));
+  }
+}
+
+std::string Format(const char* pattern, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), pattern, value);
+  return buffer;
+}
+
+}  // namespace
+
+std::string ReadTextFile(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw InputError(Located(path, 0, "no such " + what + " file"));
@@ -26,17 +48,9 @@ std::string ReadWholeFile(const std::string& path, const std::string& what) {
   return text.str();
 }
 
-// Strips a trailing '\r' and surrounding blanks.
-std::string Trimmed(std::string line) {
-  const size_t first = line.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  const size_t last = line.find_last_not_of(" \t\r");
-  return line.substr(first, last - first + 1);
-}
-
-// Exactly `count` finite numbers separated by `sep` (' ' means any run of blanks).
-std::vector<double> ParseNumbers(const std::string& line, char sep, size_t count,
-                                 const std::string& path, int line_no, const std::string& layout) {
+std::vector<double> ParseNumberFields(const std::string& line, char sep, size_t count,
+                                      const std::string& path, int line_no,
+                                      const std::string& layout) {
   std::vector<std::string> fields;
   if (sep == ' ') {
     std::istringstream in(line);
@@ -73,20 +87,6 @@ std::vector<double> ParseNumbers(const std::string& line, char sep, size_t count
   return values;
 }
 
-void CheckIncreasing(double t, bool first, double previous, const std::string& path, int line_no) {
-  if (!first && !(t > previous)) {
-    throw InputError(Located(path, line_no, "time does not increase"));
-  }
-}
-
-std::string Format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), pattern, value);
-  return buffer;
-}
-
-}  // namespace
-
 std::vector<StampedPose> ParseTum(const std::string& text, const std::string& path) {
   std::vector<StampedPose> poses;
   std::istringstream in(text);
@@ -96,7 +96,8 @@ std::vector<StampedPose> ParseTum(const std::string& text, const std::string& pa
     ++line_no;
     const std::string line = Trimmed(raw);
     if (line.empty() || line[0] == '#') continue;
-    const std::vector<double> v = ParseNumbers(line, ' ', 8, path, line_no, "t x y z qx qy qz qw");
+    const std::vector<double> v =
+        ParseNumberFields(line, ' ', 8, path, line_no, "t x y z qx qy qz qw");
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > kUnitQuaternionTol) {
       throw InputError(Located(path, line_no, "the quaternion is not of unit length"));
@@ -113,7 +114,7 @@ std::vector<StampedPose> ParseTum(const std::string& text, const std::string& pa
 }
 
 std::vector<StampedPose> ReadTum(const std::string& path) {
-  return ParseTum(ReadWholeFile(path, "trajectory"), path);
+  return ParseTum(ReadTextFile(path, "trajectory"), path);
 }
 
 std::string FormatTum(const std::vector<StampedPose>& poses) {
@@ -148,8 +149,11 @@ std::vector<PriorRecord> ParsePriors(const std::string& text, const std::string&
       header_seen = true;
       continue;
     }
-    const std::vector<double> v = ParseNumbers(line, ',', 6, path, line_no, kPriorCsvHeader);
-    if (v[4] < 0.0) throw InputError(Located(path, line_no, "height must be >= 0"));
+    const std::vector<double> v = ParseNumberFields(line, ',', 6, path, line_no, kPriorCsvHeader);
+    if (v[4] <= 0.0) {
+      throw InputError(
+          Located(path, line_no, "height: not a camera height (metres above the floor, > 0)"));
+    }
     if (std::abs(v[5]) > 90.0)
       throw InputError(Located(path, line_no, "tilt must be in [-90, 90]"));
     CheckIncreasing(v[0], records.empty(), records.empty() ? 0.0 : records.back().t, path, line_no);
@@ -163,7 +167,7 @@ std::vector<PriorRecord> ParsePriors(const std::string& text, const std::string&
 }
 
 std::vector<PriorRecord> ReadPriors(const std::string& path) {
-  return ParsePriors(ReadWholeFile(path, "prior"), path);
+  return ParsePriors(ReadTextFile(path, "prior"), path);
 }
 
 std::string FormatPriors(const std::vector<PriorRecord>& records) {

@@ -11,6 +11,15 @@
 
 namespace linetrack {
 
+// The whole text of a file; throws InputError naming it ("no such `what` file", "cannot read").
+std::string ReadTextFile(const std::string& path, const std::string& what);
+
+// Exactly `count` finite numbers separated by `sep` (' ' means any run of blanks; fields are
+// trimmed). Throws InputError naming path:line_no and, on a wrong count, the `layout`.
+std::vector<double> ParseNumberFields(const std::string& line, char sep, size_t count,
+                                      const std::string& path, int line_no,
+                                      const std::string& layout);
+
 // One pose of a trajectory: time (seconds) and the pose of the camera frame (ViSP axes) in the
 // world frame, world_from_cam (the inverse of cam_from_world).
 struct StampedPose {
@@ -30,7 +39,7 @@ std::vector<StampedPose> ReadTum(const std::string& path);
 std::string FormatTum(const std::vector<StampedPose>& poses);
 
 // One row of a prior file: time (seconds) and the prior pose (x, y metres; heading, tilt radians
-// in memory, degrees in the file; height metres), conventions of method.md.
+// in memory, degrees in the file; height metres), conventions of docs/conventions.md.
 struct PriorRecord {
   double t = 0.0;
   RobotPose pose;

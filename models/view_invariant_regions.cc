@@ -1,214 +1,29 @@
-// Construction of the view-invariant regions (docs/models.md): a convex decomposition of the
-// navigable area by the lines of its boundary, of the occluders and of a grid, refined by the
-// event rays; then a conservative visibility list per region.
+// Construction of the view-invariant regions (docs/models.md), storey by storey: the cells of the
+// navigable area (models/vir_cells.h), then a conservative visibility list per region.
 #include "models/view_invariant_regions.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
 
 #include "models/convex_polygon.h"
 #include "models/errors.h"
 #include "models/plan_arrangement.h"
 #include "models/plan_visibility.h"
+#include "models/segment_grid.h"
+#include "models/vir_cells.h"
 
 namespace linetrack {
 namespace {
 
-// Cells thinner than this are not cut off (m^2); points closer than this are one (metres).
-constexpr double kMinCellArea = 1e-8;
+// Points closer than this are one (metres).
 constexpr double kPlanTolerance = 1e-6;
-
-struct Cell {
-  Ring2 ring;
-  Eigen::Vector2d lo, hi;  // bounding box
-};
-
-Cell MakeCell(Ring2 ring) {
-  Cell cell{std::move(ring), {}, {}};
-  cell.lo = cell.hi = cell.ring.front();
-  for (const Eigen::Vector2d& p : cell.ring) {
-    cell.lo = cell.lo.cwiseMin(p);
-    cell.hi = cell.hi.cwiseMax(p);
-  }
-  return cell;
-}
-
-// One sign per undirected line, so that duplicates sort next to each other.
-Line2 Canonical(Line2 line) {
-  if (line.normal.x() < -1e-12 || (std::abs(line.normal.x()) <= 1e-12 && line.normal.y() < 0.0)) {
-    line.normal = -line.normal;
-    line.offset = -line.offset;
-  }
-  return line;
-}
-
-// Splits every cell that `line` cuts (only cells whose box meets [lo, hi] when given).
-void SplitCells(const Line2& line, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
-                const Segment2* segment, std::vector<Cell>* cells) {
-  const size_t count = cells->size();
-  for (size_t i = 0; i < count; ++i) {
-    Cell& cell = (*cells)[i];
-    if ((cell.hi.array() < lo.array()).any() || (cell.lo.array() > hi.array()).any()) continue;
-    if (segment != nullptr) {
-      double t0 = 0.0, t1 = 0.0;
-      if (!ClipSegmentToConvex(cell.ring, *segment, &t0, &t1) ||
-          (t1 - t0) * segment->Length() < kPlanTolerance) {
-        continue;
-      }
-    }
-    Ring2 positive, negative;
-    if (!SplitConvex(cell.ring, line, kMinCellArea, &positive, &negative)) continue;
-    cell = MakeCell(std::move(positive));
-    cells->push_back(MakeCell(std::move(negative)));
-  }
-}
-
-// The navigable area's bounding box cut by the lines of its boundary, of the occluders and of the
-// grid; the cells inside the area (outer boundary minus holes) are kept.
-std::vector<Cell> InitialCells(const NavigableArea& area, const std::vector<Segment2>& occluders,
-                               double grid_pitch) {
-  const Eigen::Vector2d lo = area.BoundsMin(), hi = area.BoundsMax();
-  std::vector<Line2> lines;
-  auto add_ring = [&](const Polygon2& polygon) {
-    for (size_t i = 0; i < polygon.vertices.size(); ++i) {
-      const Eigen::Vector2d& a = polygon.vertices[i];
-      const Eigen::Vector2d& b = polygon.vertices[(i + 1) % polygon.vertices.size()];
-      if ((b - a).norm() > kPlanTolerance) lines.push_back(Canonical(Line2::Through(a, b)));
-    }
-  };
-  add_ring(area.outer());
-  for (const Polygon2& hole : area.holes())
-    add_ring(hole);
-  for (const Segment2& s : occluders)
-    lines.push_back(Canonical(Line2::Through(s.a, s.b)));
-  if (grid_pitch > 0.0) {
-    for (double x = lo.x() + grid_pitch; x < hi.x() - 1e-3 * grid_pitch; x += grid_pitch) {
-      lines.push_back({Eigen::Vector2d::UnitX(), x});
-    }
-    for (double y = lo.y() + grid_pitch; y < hi.y() - 1e-3 * grid_pitch; y += grid_pitch) {
-      lines.push_back({Eigen::Vector2d::UnitY(), y});
-    }
-  }
-  std::sort(lines.begin(), lines.end(), [](const Line2& a, const Line2& b) {
-    const double angle_a = std::atan2(a.normal.y(), a.normal.x());
-    const double angle_b = std::atan2(b.normal.y(), b.normal.x());
-    return angle_a != angle_b ? angle_a < angle_b : a.offset < b.offset;
-  });
-  std::vector<Cell> cells = {MakeCell({lo, {hi.x(), lo.y()}, hi, {lo.x(), hi.y()}})};
-  const Line2* previous = nullptr;
-  for (const Line2& line : lines) {
-    if (previous != nullptr && (line.normal - previous->normal).norm() < 1e-9 &&
-        std::abs(line.offset - previous->offset) < kPlanTolerance) {
-      continue;
-    }
-    SplitCells(line, lo, hi, nullptr, &cells);
-    previous = &line;
-  }
-  std::vector<Cell> inside;
-  for (Cell& cell : cells) {
-    const Eigen::Vector2d c = RingCentroid(cell.ring);
-    if (!area.outer().Contains(c)) continue;
-    const bool in_hole = std::any_of(area.holes().begin(), area.holes().end(),
-                                     [&](const Polygon2& hole) { return hole.Contains(c); });
-    if (!in_hole) inside.push_back(std::move(cell));
-  }
-  return inside;
-}
-
-// True when segment a-b crosses the occluder at a point away from a and b.
-bool CrossesBetween(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Segment2& o) {
-  const Eigen::Vector2d d = b - a, e = o.b - o.a;
-  const double denom = Cross2(d, e);
-  if (std::abs(denom) <= 1e-12 * d.norm() * e.norm()) return false;  // parallel: grazing
-  const double t = Cross2(o.a - a, e) / denom, u = Cross2(o.a - a, d) / denom;
-  const double margin = kPlanTolerance / d.norm();
-  return t > margin && t < 1.0 - margin && u >= 0.0 && u <= 1.0;
-}
-
-// Event rays (Simsarian et al. 1996): from an occluding vertex c, away from a model vertex v that
-// c can start to hide (v sees c, and the walls at c lie on one side of the line v-c), up to the
-// next occluder or the area's box. Crossing one makes v appear or disappear behind c.
-std::vector<Segment2> EventRays(const WireframeModel& model, const std::vector<Segment2>& occluders,
-                                const NavigableArea& area) {
-  std::vector<PlanWall> walls;
-  for (const Segment2& s : occluders)
-    walls.push_back({s, Eigen::Vector2d::Zero()});
-  const PlanArrangement arrangement = PlanArrangement::Build(walls, kPlanTolerance);
-  std::vector<Eigen::Vector2d> points;
-  for (const Eigen::Vector3d& v : model.vertices()) {
-    const Eigen::Vector2d p = v.head<2>();
-    const bool known = std::any_of(points.begin(), points.end(), [&](const Eigen::Vector2d& q) {
-      return (q - p).norm() <= kPlanTolerance;
-    });
-    if (!known) points.push_back(p);
-  }
-  const Eigen::Vector2d lo = area.BoundsMin(), hi = area.BoundsMax();
-  std::vector<Segment2> rays;
-  for (size_t c_id = 0; c_id < arrangement.vertices().size(); ++c_id) {
-    const Eigen::Vector2d& c = arrangement.vertices()[c_id];
-    const std::vector<int>& around = arrangement.Neighbours(static_cast<int>(c_id));
-    if (around.empty() || (c.array() < lo.array()).any() || (c.array() > hi.array()).any()) {
-      continue;
-    }
-    std::vector<double> angles;
-    for (const Eigen::Vector2d& v : points) {
-      if ((c - v).norm() <= kPlanTolerance) continue;
-      const Eigen::Vector2d d = (c - v).normalized();
-      double side_lo = 0.0, side_hi = 0.0;
-      for (int w : around) {
-        const Eigen::Vector2d e = (arrangement.vertices()[w] - c).normalized();
-        side_lo = std::min(side_lo, Cross2(d, e));
-        side_hi = std::max(side_hi, Cross2(d, e));
-      }
-      if (side_lo < -1e-9 && side_hi > 1e-9) continue;  // c is not on the silhouette seen from v
-      const bool sees = std::none_of(occluders.begin(), occluders.end(),
-                                     [&](const Segment2& o) { return CrossesBetween(v, c, o); });
-      if (sees) angles.push_back(std::atan2(d.y(), d.x()));
-    }
-    std::sort(angles.begin(), angles.end());
-    for (size_t k = 0; k < angles.size(); ++k) {
-      if (k > 0 && angles[k] - angles[k - 1] < 1e-9) continue;
-      const Eigen::Vector2d d(std::cos(angles[k]), std::sin(angles[k]));
-      // Exit from the box, then the first occluder crossed.
-      double t_end = std::numeric_limits<double>::infinity();
-      for (int axis = 0; axis < 2; ++axis) {
-        if (d[axis] > 1e-15) t_end = std::min(t_end, (hi[axis] - c[axis]) / d[axis]);
-        if (d[axis] < -1e-15) t_end = std::min(t_end, (lo[axis] - c[axis]) / d[axis]);
-      }
-      for (const Segment2& o : occluders) {
-        const Eigen::Vector2d e = o.b - o.a;
-        const double denom = Cross2(d, e);
-        if (std::abs(denom) <= 1e-12 * e.norm()) continue;
-        const double t = Cross2(o.a - c, e) / denom, u = Cross2(o.a - c, d) / denom;
-        if (t > kPlanTolerance && u >= 0.0 && u <= 1.0) t_end = std::min(t_end, t);
-      }
-      if (t_end > kPlanTolerance) rays.push_back({c, c + t_end * d});
-    }
-  }
-  return rays;
-}
-
-// Convex pieces of the closed loops of occluders that contain no navigable cell.
-std::vector<Ring2> Solids(const std::vector<Segment2>& occluders, const std::vector<Cell>& cells) {
-  std::vector<PlanWall> walls;
-  for (const Segment2& s : occluders)
-    walls.push_back({s, Eigen::Vector2d::Zero()});
-  const PlanArrangement arrangement = PlanArrangement::Build(walls, kPlanTolerance);
-  std::vector<Ring2> solids;
-  for (const PlanCycle& cycle : arrangement.cycles()) {
-    if (cycle.signed_area <= kMinCellArea) continue;
-    const Ring2 ring = arrangement.CycleRing(cycle);
-    if (ring.size() < 3) continue;
-    const bool navigable = std::any_of(cells.begin(), cells.end(), [&](const Cell& cell) {
-      return RingContains(ring, RingCentroid(cell.ring));
-    });
-    if (navigable) continue;
-    for (Ring2& piece : ConvexPieces(ring))
-      solids.push_back(std::move(piece));
-  }
-  return solids;
-}
+// Event rays are cast from occluding vertices for points within this range (metres); a closed
+// loop of occluders with at most this many sides is a solid.
+constexpr double kEventRange = 15.0;
+constexpr int kMaxSolidSides = 16;
 
 // The floor-plan footprint of an edge: one point for a vertical edge, else its two end points.
 Ring2 Footprint(const ModelEdge& edge) {
@@ -217,24 +32,195 @@ Ring2 Footprint(const ModelEdge& edge) {
   return {a, b};
 }
 
-std::vector<RegionEdge> VisibilityList(const Ring2& region, const WireframeModel& model,
-                                       const std::vector<Segment2>& occluders,
-                                       const std::vector<Ring2>& solids, double margin) {
-  std::vector<RegionEdge> visible;
+// The edges one storey's regions list: those within its height band can be hidden by its
+// occluders; those outside it (seen over the walls) are listed in every region.
+struct StoreyEdges {
+  std::vector<int> ids;
+  std::vector<Ring2> footprints;                                   // per entry of ids
+  std::vector<char> in_band;                                       // per entry of ids
+  double z_lo = 0.0, z_hi = 0.0;                                   // the cameras' band (metres)
+  const std::vector<std::vector<int>>* one_sided_faces = nullptr;  // OneSidedFacesOfEdges
+};
+
+// True when segments p-q and s meet (touching counts).
+bool SegmentsMeet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Segment2& s) {
+  const Eigen::Vector2d d = q - p, e = s.b - s.a;
+  const double denom = Cross2(d, e);
+  if (std::abs(denom) <= 1e-15 * d.norm() * e.norm()) {
+    return DistanceToSegment(p, s) <= kPlanTolerance || DistanceToSegment(q, s) <= kPlanTolerance;
+  }
+  const double t = Cross2(s.a - p, e) / denom, u = Cross2(s.a - p, d) / denom;
+  return t >= -1e-9 && t <= 1.0 + 1e-9 && u >= -1e-9 && u <= 1.0 + 1e-9;
+}
+
+// The occluders and solids of one storey, in grids along which sight lines are walked.
+struct StoreyOccluders {
+  SegmentGrid walls;
+  std::vector<Ring2> solids;
+  SegmentGrid solid_sides;             // the solids' sides
+  std::vector<int> solid_of_side;      // per side: its solid
+  mutable std::vector<unsigned> seen;  // per solid: the last visibility test that met it
+  mutable unsigned test = 0;
+};
+
+// True when an occluder or a solid hides the whole footprint from the whole region: only those
+// crossing the line between their centres can (docs/models.md).
+bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footprint,
+            const StoreyOccluders& o, double margin) {
+  Eigen::Vector2d to = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& f : footprint)
+    to += f / static_cast<double>(footprint.size());
+  int crossed = 0;
+  const bool by_wall = o.walls.Along(from, to, [&](int i) {
+    const Segment2& wall = o.walls.segments()[i];
+    if (!SegmentsMeet(from, to, wall)) return false;
+    ++crossed;
+    return HiddenByWall(region, footprint, wall, margin);
+  });
+  if (by_wall) return true;
+  // The sight line between the centres is clear: the footprint is in sight. (A solid's sides are
+  // occluders: the line meets none of them either.)
+  if (crossed == 0) return false;
+  ++o.test;
+  const bool by_solid = o.solid_sides.Along(from, to, [&](int side) {
+    const int solid = o.solid_of_side[side];
+    if (o.seen[solid] == o.test) return false;
+    o.seen[solid] = o.test;
+    return HiddenBySolid(region, footprint, o.solids[solid], margin);
+  });
+  return by_solid;
+}
+
+// Per model edge, the faces it bounds when all of them are one-sided (no camera sees their back):
+// the edge is out of sight from behind all of them. Empty for 3D lines and edges of a face that
+// can be seen from both sides.
+std::vector<std::vector<int>> OneSidedFacesOfEdges(const WireframeModel& model) {
+  std::map<std::pair<int, int>, int> edge_of;
+  for (const ModelEdge& edge : model.edges())
+    edge_of[std::minmax(edge.v0, edge.v1)] = edge.id;
+  std::vector<std::vector<int>> faces(model.edges().size());
+  std::vector<char> seen_behind(model.edges().size(), 0);
+  for (size_t f = 0; f < model.faces().size(); ++f) {
+    const std::vector<int>& v = model.faces()[f].vertices;
+    for (size_t i = 0; i < v.size(); ++i) {
+      const auto it = edge_of.find(std::minmax(v[i], v[(i + 1) % v.size()]));
+      if (it == edge_of.end()) continue;
+      faces[it->second].push_back(static_cast<int>(f));
+      if (!model.faces()[f].one_sided) seen_behind[it->second] = 1;
+    }
+  }
   for (const ModelEdge& edge : model.edges()) {
-    const Ring2 footprint = Footprint(edge);
-    const bool hidden = std::any_of(occluders.begin(), occluders.end(),
-                                    [&](const Segment2& o) {
-                                      return HiddenByWall(region, footprint, o, margin);
-                                    }) ||
-                        std::any_of(solids.begin(), solids.end(), [&](const Ring2& solid) {
-                          return HiddenBySolid(region, footprint, solid, margin);
-                        });
-    if (hidden) continue;
+    if (edge.from_line || seen_behind[edge.id]) faces[edge.id].clear();
+  }
+  return faces;
+}
+
+// True when the region (cameras between z_lo and z_hi) lies behind the face's plane by `margin`.
+bool Behind(const ModelFace& face, const Ring2& region, double z_lo, double z_hi, double margin) {
+  if (face.vertical) {
+    const Eigen::Vector2d n = face.normal.head<2>();
+    return std::all_of(region.begin(), region.end(),
+                       [&](const Eigen::Vector2d& p) { return n.dot(p) - face.offset < -margin; });
+  }
+  if (face.horizontal) {
+    const double z = face.corners.front().z();
+    return face.normal.z() > 0.0 ? z > z_hi + margin : z < z_lo - margin;
+  }
+  return false;
+}
+
+// The visibility list of a region among the candidate edges (the storey's, or the list of the
+// cell it was split from: a region inside a cell sees no more than the cell).
+std::vector<RegionEdge> VisibilityList(const Ring2& region, const WireframeModel& model,
+                                       const StoreyEdges& edges, const std::vector<int>& candidates,
+                                       const StoreyOccluders& occluders, double margin) {
+  std::vector<RegionEdge> visible;
+  visible.reserve(candidates.size());
+  const Eigen::Vector2d centre = RingCentroid(region);
+  for (int k : candidates) {
+    const ModelEdge& edge = model.edges()[edges.ids[k]];
+    const std::vector<int>& faces = (*edges.one_sided_faces)[edge.id];
+    if (!faces.empty() && std::all_of(faces.begin(), faces.end(), [&](int f) {
+          return Behind(model.faces()[f], region, edges.z_lo, edges.z_hi, margin);
+        })) {
+      continue;
+    }
+    const Ring2& footprint = edges.footprints[k];
+    if (edges.in_band[k] && Hidden(region, centre, footprint, occluders, margin)) continue;
     const BearingRange range = BearingsToFootprint(region, footprint);
     visible.push_back({edge.id, range.min, range.max, range.all});
   }
   return visible;
+}
+
+// Distinct floor-plan points of the ends of the edges `ids`.
+std::vector<Eigen::Vector2d> PlanPoints(const WireframeModel& model, const std::vector<int>& ids) {
+  std::vector<Eigen::Vector2d> points;
+  for (int id : ids) {
+    for (const Eigen::Vector3d& end : {model.edges()[id].segment.a, model.edges()[id].segment.b})
+      points.push_back(end.head<2>());
+  }
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+  });
+  std::vector<Eigen::Vector2d> distinct;
+  for (const Eigen::Vector2d& p : points) {
+    const bool known = std::any_of(distinct.rbegin(), distinct.rend(),
+                                   [&](const auto& q) { return (q - p).norm() <= kPlanTolerance; });
+    if (!known) distinct.push_back(p);
+  }
+  return distinct;
+}
+
+// True when horizontal faces with z in [z_lo, z_hi] (a slab between two storeys, door heads) lie
+// over the centroid of every cell.
+bool SlabCovers(const WireframeModel& model, const std::vector<Cell>& cells, double z_lo,
+                double z_hi) {
+  std::vector<Ring2> slab;
+  for (const ModelFace& face : model.faces()) {
+    if (!face.horizontal || face.Degenerate()) continue;
+    const double z = face.corners.front().z();
+    if (z < z_lo || z > z_hi) continue;
+    Ring2 ring;
+    for (const Eigen::Vector3d& c : face.corners)
+      ring.push_back(c.head<2>());
+    slab.push_back(std::move(ring));
+  }
+  return !cells.empty() && std::all_of(cells.begin(), cells.end(), [&](const Cell& cell) {
+    const Eigen::Vector2d c = RingCentroid(cell.ring);
+    return std::any_of(slab.begin(), slab.end(),
+                       [&](const Ring2& ring) { return RingContains(ring, c); });
+  });
+}
+
+// The edges storey s lists. A slab that covers the storey above (below) hides everything above
+// its walls' top (below its floor): those edges are dropped, and the others are seen only through
+// their part within the band, where the storey's occluders hide them. Without a slab, edges
+// beyond the band [z_lo, z_hi] (metres) may be seen over the walls: never hidden.
+StoreyEdges EdgesOfStorey(const WireframeModel& model, const std::vector<Storey>& storeys, int s,
+                          const std::vector<Cell>& cells, double z_lo, double z_hi) {
+  constexpr double kTol = 0.05;
+  const int n = static_cast<int>(storeys.size());
+  // Above a region: a ceiling, or a door head, anywhere above the cameras' feet.
+  const bool closed_below =
+      s > 0 && SlabCovers(model, cells, storeys[s - 1].top_z - kTol, storeys[s].floor_z + kTol);
+  const bool closed_above = s + 1 < n && SlabCovers(model, cells, storeys[s].floor_z + kTol,
+                                                    storeys[s + 1].floor_z + kTol);
+  StoreyEdges edges;
+  for (const ModelEdge& edge : model.edges()) {
+    const double e_lo = std::min(edge.segment.a.z(), edge.segment.b.z());
+    const double e_hi = std::max(edge.segment.a.z(), edge.segment.b.z());
+    if ((closed_above && e_lo > storeys[s].top_z + kTol) ||
+        (closed_below && e_hi < storeys[s].floor_z - kTol)) {
+      continue;
+    }
+    edges.ids.push_back(edge.id);
+    edges.footprints.push_back(Footprint(edge));
+    const bool in_band =
+        (closed_below || e_lo >= z_lo - kTol) && (closed_above || e_hi <= z_hi + kTol);
+    edges.in_band.push_back(in_band ? 1 : 0);
+  }
+  return edges;
 }
 
 }  // namespace
@@ -250,6 +236,14 @@ bool ViewInvariantRegionsOptions::Check(std::string* why) const {
   }
   if (!(grid_pitch == 0.0 || (grid_pitch >= 0.05 && grid_pitch <= 1e3))) {
     *why = "grid_pitch must be 0 (no grid) or in [0.05, 1000] metres";
+    return false;
+  }
+  if (!(event_ray_separation_deg >= 0.0 && event_ray_separation_deg <= 90.0)) {
+    *why = "event_ray_separation_deg must be in [0, 90] degrees";
+    return false;
+  }
+  if (!(min_region_size >= 0.0 && min_region_size <= 100.0)) {
+    *why = "min_region_size must be in [0, 100] metres";
     return false;
   }
   if (!(hidden_margin >= 1e-6 && hidden_margin < 0.1)) {
@@ -270,27 +264,90 @@ ViewInvariantRegions ViewInvariantRegions::Build(const WireframeModel& model,
     const Ring2 footprint = Footprint(edge);
     vir.footprints_.push_back({footprint.front(), footprint.back()});
   }
-  if (area.outer().vertices.size() < 3) return vir;
-  vir.occluders_ = FullHeightOccluders(model, options.full_height_tolerance, options.camera_top);
-  std::vector<Cell> cells = InitialCells(area, vir.occluders_, options.grid_pitch);
-  if (options.event_rays) {
-    for (const Segment2& ray : EventRays(model, vir.occluders_, area)) {
-      SplitCells(Line2::Through(ray.a, ray.b), ray.a.cwiseMin(ray.b), ray.a.cwiseMax(ray.b), &ray,
-                 &cells);
+  vir.storeys_ = area.storeys();
+  for (int s = 0; s < static_cast<int>(area.storeys().size()); ++s)
+    vir.BuildStorey(model, area, s, options);
+  vir.BuildGrid(area);
+  return vir;
+}
+
+void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const NavigableArea& area,
+                                       int s, const ViewInvariantRegionsOptions& options) {
+  std::vector<const AreaPart*> parts;
+  for (const AreaPart& part : area.parts()) {
+    if (part.storey == s && part.outer.vertices.size() >= 3) parts.push_back(&part);
+  }
+  if (parts.empty()) return;
+  const std::vector<Storey>& storeys = area.storeys();
+  const double tol = options.full_height_tolerance;
+  const double z_lo = storeys[s].floor_z, z_hi = std::max(storeys[s].top_z, options.camera_top);
+  const std::vector<Segment2> walls = OccludersInBand(model, z_lo + tol, z_hi - tol);
+  std::vector<Segment2> stoppers = walls;
+  Eigen::Vector2d lo = parts.front()->outer.vertices.front(), hi = lo;
+  for (const AreaPart* part : parts) {
+    for (const Polygon2* ring : {&part->outer}) {
+      for (size_t i = 0; i < ring->vertices.size(); ++i) {
+        stoppers.push_back({ring->vertices[i], ring->vertices[(i + 1) % ring->vertices.size()]});
+        lo = lo.cwiseMin(ring->vertices[i]), hi = hi.cwiseMax(ring->vertices[i]);
+      }
+    }
+    for (const Polygon2& hole : part->holes) {
+      for (size_t i = 0; i < hole.vertices.size(); ++i)
+        stoppers.push_back({hole.vertices[i], hole.vertices[(i + 1) % hole.vertices.size()]});
     }
   }
-  const std::vector<Ring2> solids = Solids(vir.occluders_, cells);
-  for (const Ring2& solid : solids)
-    vir.solids_.push_back(Polygon2{solid});
+  std::vector<Cell> cells =
+      InitialCells(parts, SegmentGrid(std::move(stoppers)), options.grid_pitch);
+  const std::vector<Cell> initial = cells;
+  StoreyEdges edges = EdgesOfStorey(model, storeys, s, cells, z_lo, z_hi);
+  const std::vector<std::vector<int>> one_sided = OneSidedFacesOfEdges(model);
+  edges.z_lo = z_lo;
+  edges.z_hi = z_hi;
+  edges.one_sided_faces = &one_sided;
+  StoreyOccluders occluders{SegmentGrid(walls), {}, SegmentGrid({}), {}, {}, 0};
+  occluders.solids = Solids(walls, cells, kMaxSolidSides);
+  if (options.event_rays) {
+    EventRayOptions rays;
+    rays.range = kEventRange;
+    rays.min_separation = DegToRad(options.event_ray_separation_deg);
+    for (const Segment2& ray : EventRays(PlanPoints(model, edges.ids), occluders.walls,
+                                         occluders.solids, Eigen::AlignedBox2d(lo, hi), rays)) {
+      SplitCells(ray, &cells, options.min_region_size);
+    }
+  }
+  std::vector<Segment2> sides;
+  for (size_t k = 0; k < occluders.solids.size(); ++k) {
+    const Ring2& solid = occluders.solids[k];
+    for (size_t i = 0; i < solid.size(); ++i) {
+      sides.push_back({solid[i], solid[(i + 1) % solid.size()]});
+      occluders.solid_of_side.push_back(static_cast<int>(k));
+    }
+    solids_.push_back(Polygon2{solid});
+  }
+  occluders.solid_sides = SegmentGrid(std::move(sides));
+  occluders.seen.assign(occluders.solids.size(), 0);
+  occluders_.insert(occluders_.end(), walls.begin(), walls.end());
+  // The initial cells' lists first; a region split from one tests only its cell's list.
+  std::vector<int> all(edges.ids.size());
+  std::iota(all.begin(), all.end(), 0);
+  std::vector<std::vector<int>> parent_lists;
+  for (const Cell& cell : initial) {
+    std::vector<int> listed;
+    for (const RegionEdge& e :
+         VisibilityList(cell.ring, model, edges, all, occluders, options.hidden_margin)) {
+      listed.push_back(static_cast<int>(
+          std::lower_bound(edges.ids.begin(), edges.ids.end(), e.edge_id) - edges.ids.begin()));
+    }
+    parent_lists.push_back(std::move(listed));
+  }
   for (const Cell& cell : cells) {
     ViewRegion region;
     region.polygon.vertices = cell.ring;
-    region.visible =
-        VisibilityList(cell.ring, model, vir.occluders_, solids, options.hidden_margin);
-    vir.regions_.push_back(std::move(region));
+    region.storey = s;
+    region.visible = VisibilityList(cell.ring, model, edges, parent_lists[cell.parent], occluders,
+                                    options.hidden_margin);
+    regions_.push_back(std::move(region));
   }
-  vir.BuildGrid(area);
-  return vir;
 }
 
 }  // namespace linetrack

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,9 +26,10 @@ struct RegionEdge {
   bool all_bearings = false;
 };
 
-// A convex cell of the navigable area and its visibility list (sorted by edge id).
+// A convex cell of the navigable area on one storey and its visibility list (sorted by edge id).
 struct ViewRegion {
   Polygon2 polygon;
+  int storey = 0;
   std::vector<RegionEdge> visible;
 };
 
@@ -40,15 +42,18 @@ struct VisibilityQuery {
   // Largest angle (radians) between the heading and the floor-plane bearing of anything in the
   // image; see BearingHalfWidth().
   double bearing_half_width = 0.0;
+  // World height of the camera (metres): only the regions of its storey answer; NaN: every
+  // storey's.
+  double camera_z = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ViewInvariantRegionsOptions {
-  // Only faces spanning the model's whole height (floor to ceiling) occlude in the plan; lower
-  // faces are conservatively treated as transparent. Tolerance on that test (metres).
+  // Only faces spanning a storey's whole height (floor to the top of its walls) occlude in the
+  // plan; lower faces are conservatively treated as transparent. Tolerance on that test (metres).
   double full_height_tolerance = 0.01;
   // Highest camera position the lists must hold for (world z, metres): a face occludes only when
-  // it also reaches above it. The default 0 is below the top of a model standing on z = 0, so the
-  // model's top is used; raise it for cameras above low models.
+  // it also reaches above it. The default 0 is below the top of a storey standing on z >= 0, so
+  // the storey's top is used; raise it for cameras above low models.
   double camera_top = 0.0;
   // Regions are also cut by a square grid of this pitch (metres; 0: no grid), which bounds their
   // size and so the width of their bearing ranges (the query's own disk test mostly does that).
@@ -56,6 +61,14 @@ struct ViewInvariantRegionsOptions {
   // Cut by the event rays (from an occluding vertex away from each model vertex it can hide, up
   // to the next wall; Simsarian et al.), not only by the lines of walls and area boundaries.
   bool event_rays = true;
+  // Of the event rays from one occluding vertex, only those at least this far apart (degrees):
+  // each door jamb sees hundreds of model vertices, and their rays crossing in a corridor cut it
+  // into cells quadratic in number. Fewer rays leave coarser regions, whose lists stay
+  // conservative.
+  double event_ray_separation_deg = 5.0;
+  // Event rays split no region already under this size (metres) on both sides of its bounding
+  // box: the matcher queries disks of the prior's position uncertainty, larger than this.
+  double min_region_size = 0.5;
   // An edge counts as hidden only when the occluders block every sight line to it by at least
   // this much (metres); keeps the lists conservative against rounding and grazing sight lines.
   double hidden_margin = 1e-3;
@@ -65,31 +78,41 @@ struct ViewInvariantRegionsOptions {
 
 class ViewInvariantRegions {
  public:
-  // Regions of `area` and their visibility lists for `model` (docs/models.md); throws InputError
-  // naming the model when the options are invalid.
+  // Regions of `area` and their visibility lists for `model`, storey by storey
+  // (docs/models.md); throws InputError naming the model when the options are invalid.
   static ViewInvariantRegions Build(const WireframeModel& model, const NavigableArea& area,
                                     const ViewInvariantRegionsOptions& options = {});
 
   const std::vector<ViewRegion>& regions() const { return regions_; }
   int size() const { return static_cast<int>(regions_.size()); }
-  // Floor-plan segments of the full-height faces, the occluders the lists were built with.
+  // Floor-plan segments of the full-height faces, the occluders the lists were built with (every
+  // storey's).
   const std::vector<Segment2>& occluders() const { return occluders_; }
   // Convex pieces of the closed loops of occluders no camera can be inside (pillars, boxes).
   const std::vector<Polygon2>& solids() const { return solids_; }
 
   // Edges possibly visible from the query (sorted ids, each once): the union of the visibility
-  // lists of the regions meeting the disk, keeping an edge when its bearing range meets
-  // [heading - margin - half_width, heading + margin + half_width], and so do the bearings from
-  // the disk itself to the edge. Conservative: an edge that ray casting finds visible from a pose
-  // inside the query (position in the navigable area, camera height between the model's floor
-  // and top) is never missing. Throws InputError on a non-finite or negative field.
+  // lists of the regions of the camera's storey meeting the disk, keeping an edge when its bearing
+  // range meets [heading - margin - half_width, heading + margin + half_width], and so do the
+  // bearings from the disk itself to the edge. Conservative: an edge that ray casting finds visible
+  // from a pose inside the query (position in the navigable area, camera height between the model's
+  // floor and top) is never missing. Throws InputError on a non-finite or negative field.
   std::vector<int> Query(const VisibilityQuery& query) const;
+
+  // Why Query(query) is empty, for a localisation's reason: the disk meets no region of the
+  // camera's storey (it lies outside the navigable area), or the regions it meets see no edge
+  // under the query's bearings.
+  std::string ExplainEmptyQuery(const VisibilityQuery& query) const;
 
  private:
   // Fills the grid below from the regions' bounding boxes.
   void BuildGrid(const NavigableArea& area);
+  // Adds the regions of storey s.
+  void BuildStorey(const WireframeModel& model, const NavigableArea& area, int s,
+                   const ViewInvariantRegionsOptions& options);
 
   std::vector<ViewRegion> regions_;
+  std::vector<Storey> storeys_;
   std::vector<Segment2> occluders_;
   std::vector<Polygon2> solids_;
   int num_edges_ = 0;

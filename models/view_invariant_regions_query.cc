@@ -1,10 +1,13 @@
 // Queries of the view-invariant regions, and the bearing half-width of a camera's image.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 #include "models/convex_polygon.h"
 #include "models/errors.h"
+#include "models/free_space.h"
 #include "models/robot_pose.h"
 #include "models/view_invariant_regions.h"
 
@@ -39,6 +42,12 @@ bool DiskBearings(const Segment2& footprint, const Eigen::Vector2d& centre, doub
   *arc_centre = reference + 0.5 * (lo + hi);
   *arc_half = 0.5 * (hi - lo);
   return true;
+}
+
+std::string Fixed(double value, int digits = 2) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
+  return buffer;
 }
 
 }  // namespace
@@ -105,12 +114,15 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
   std::sort(candidates.begin(), candidates.end());
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
 
+  const int storey =
+      std::isfinite(query.camera_z) && !storeys_.empty() ? StoreyAt(storeys_, query.camera_z) : -1;
   const double half = query.heading_margin + query.bearing_half_width;
   const bool any_bearing = half >= kPi;
   // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
   std::vector<char> state(num_edges_, 0);
   for (int r : candidates) {
     const ViewRegion& region = regions_[r];
+    if (storey >= 0 && region.storey != storey) continue;
     if (DistanceToConvex(region.polygon.vertices, query.centre) > query.radius + 1e-9) continue;
     for (const RegionEdge& e : region.visible) {
       if (state[e.edge_id] != 0) continue;
@@ -133,6 +145,30 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
     if (state[id] == 1) ids.push_back(id);
   }
   return ids;
+}
+
+std::string ViewInvariantRegions::ExplainEmptyQuery(const VisibilityQuery& query) const {
+  const int storey =
+      std::isfinite(query.camera_z) && !storeys_.empty() ? StoreyAt(storeys_, query.camera_z) : -1;
+  const std::string where =
+      "(" + Fixed(query.centre.x()) + ", " + Fixed(query.centre.y()) + ") +- " +
+      Fixed(query.radius) + " m" +
+      (storey >= 0 && storeys_.size() > 1 ? " on storey " + std::to_string(storey) : std::string());
+  int met = 0, listing = 0;
+  for (const ViewRegion& region : regions_) {
+    if ((storey >= 0 && region.storey != storey) ||
+        DistanceToConvex(region.polygon.vertices, query.centre) > query.radius + 1e-9) {
+      continue;
+    }
+    ++met;
+    listing += region.visible.empty() ? 0 : 1;
+  }
+  if (regions_.empty()) return "the model has no navigable area to localise in";
+  if (met == 0) return "the prior " + where + " lies outside the navigable area";
+  if (listing == 0) return "no model edge is visible from the prior " + where;
+  return "no model edge is visible from the prior " + where + " under headings " +
+         Fixed(RadToDeg(query.heading), 1) + " +- " +
+         Fixed(RadToDeg(query.heading_margin + query.bearing_half_width), 1) + " deg";
 }
 
 double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max) {

@@ -1,5 +1,6 @@
 #include "models/wireframe.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -7,6 +8,8 @@
 #include <utility>
 
 #include "models/errors.h"
+#include "models/face_orientation.h"
+#include "models/free_space.h"
 
 namespace linetrack {
 namespace {
@@ -61,6 +64,68 @@ Eigen::Vector3d NewellNormal(const std::vector<Eigen::Vector3d>& corners) {
   return n;
 }
 
+// The face through `vertices` (ids into `all`), its plane from Newell's normal; a zero normal
+// when the polygon has no area.
+ModelFace MakeFace(const std::vector<int>& vertices, const std::vector<Eigen::Vector3d>& all,
+                   const std::string& name) {
+  ModelFace face;
+  face.name = name;
+  face.vertices = vertices;
+  for (int v : vertices)
+    face.corners.push_back(all[v]);
+  const Eigen::Vector3d n = NewellNormal(face.corners);
+  double extent = 0.0;
+  for (const Eigen::Vector3d& c : face.corners)
+    extent = std::max(extent, (c - face.corners[0]).norm());
+  if (n.norm() > 1e-9 * std::max(1.0, extent * extent)) {
+    face.normal = n.normalized();
+    face.offset = face.normal.dot(face.corners[0]);
+    face.vertical = std::abs(face.normal.z()) < 1e-6;
+    face.horizontal = std::abs(std::abs(face.normal.z()) - 1.0) < 1e-9;
+  }
+  return face;
+}
+
+// names[i], or "" when the list is shorter (a CaoModel built without names).
+std::string NameAt(const std::vector<std::string>& names, size_t i) {
+  return i < names.size() ? names[i] : std::string();
+}
+
+// The distinct non-empty names, in order, joined by '/'.
+std::string JoinedNames(const std::vector<std::string>& names) {
+  std::string joined;
+  std::vector<std::string> seen;
+  for (const std::string& name : names) {
+    if (name.empty() || std::find(seen.begin(), seen.end(), name) != seen.end()) continue;
+    seen.push_back(name);
+    joined += (joined.empty() ? "" : "/") + name;
+  }
+  return joined;
+}
+
+// The faces of `cao` on the merged vertices, with their planes and names; counts those without
+// area.
+std::vector<ModelFace> BuildFaces(const CaoModel& cao, const std::vector<int>& vertex_of_point,
+                                  const std::vector<Eigen::Vector3d>& vertices, int* degenerate) {
+  std::vector<ModelFace> faces;
+  for (size_t f = 0; f < cao.faces.size(); ++f) {
+    std::vector<int> ids;
+    for (int p : cao.faces[f])
+      ids.push_back(vertex_of_point[p]);
+    faces.push_back(MakeFace(ids, vertices, NameAt(cao.face_names, f)));
+    *degenerate += faces.back().Degenerate() ? 1 : 0;
+  }
+  return faces;
+}
+
+void Flip(ModelFace* face) {
+  std::reverse(face->vertices.begin(), face->vertices.end());
+  std::reverse(face->corners.begin(), face->corners.end());
+  face->normal = -face->normal;
+  face->offset = -face->offset;
+  face->flipped = !face->flipped;
+}
+
 }  // namespace
 
 bool WireframeOptions::Check(std::string* why) const {
@@ -97,17 +162,36 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     }
   }
 
+  int degenerate_faces = 0;
+  model.faces_ = BuildFaces(cao, vertex_of_point, model.vertices_, &degenerate_faces);
+  model.storeys_ = DetectStoreys(model.faces_, model.box_min_.z(), model.box_max_.z());
+  if (options.orient_faces) {
+    const std::vector<FaceOrientation> orientation = OrientFaces(model);
+    model.oriented_ = !orientation.empty();
+    for (size_t f = 0; f < orientation.size(); ++f) {
+      if (orientation[f].flip) Flip(&model.faces_[f]);
+      model.faces_[f].two_sided = orientation[f].rule == OrientationRule::kTwoSided;
+      model.faces_[f].one_sided = orientation[f].rule == OrientationRule::kFreeSide ||
+                                  orientation[f].rule == OrientationRule::kOutsideSide;
+    }
+    model.orientation_summary_ = OrientationSummary(model, orientation);
+  }
+
+  // Edges after orientation: a face's edges are numbered in its (oriented) point order.
   const double cos_vertical = std::cos(DegToRad(options.vertical_tolerance_deg));
   std::map<std::pair<int, int>, int> edge_of_vertices;
   int degenerate = 0;
-  auto add_edge = [&](int p0, int p1, bool from_line, int face) {
-    const int v0 = vertex_of_point[p0], v1 = vertex_of_point[p1];
+  std::vector<std::vector<std::string>> face_names_of_edge;  // per edge, the named faces it borders
+  auto add_edge = [&](int v0, int v1, bool from_line, int face, const std::string& name) {
     if (v0 == v1) {
       ++degenerate;
       return;
     }
     const auto key = std::minmax(v0, v1);
-    if (edge_of_vertices.count(key)) return;
+    if (const auto known = edge_of_vertices.find(key); known != edge_of_vertices.end()) {
+      if (face >= 0) face_names_of_edge[known->second].push_back(name);
+      return;
+    }
     ModelEdge edge;
     edge.id = static_cast<int>(model.edges_.size());
     edge.v0 = v0;
@@ -116,43 +200,29 @@ WireframeModel WireframeModel::FromCao(const CaoModel& cao, const WireframeOptio
     edge.vertical = std::abs(edge.segment.Direction().z()) >= cos_vertical;
     edge.from_line = from_line;
     edge.face = face;
+    if (from_line) edge.name = name;
     edge_of_vertices[key] = edge.id;
     model.edges_.push_back(edge);
+    face_names_of_edge.emplace_back();
+    if (face >= 0) face_names_of_edge.back().push_back(name);
   };
-
-  for (const auto& line : cao.lines)
-    add_edge(line[0], line[1], true, -1);
-  for (size_t f = 0; f < cao.faces.size(); ++f) {
-    const std::vector<int>& face = cao.faces[f];
+  for (size_t l = 0; l < cao.lines.size(); ++l) {
+    add_edge(vertex_of_point[cao.lines[l][0]], vertex_of_point[cao.lines[l][1]], true, -1,
+             NameAt(cao.line_names, l));
+  }
+  for (size_t f = 0; f < model.faces_.size(); ++f) {
+    const std::vector<int>& face = model.faces_[f].vertices;
     for (size_t i = 0; i < face.size(); ++i) {
-      add_edge(face[i], face[(i + 1) % face.size()], false, static_cast<int>(f));
+      add_edge(face[i], face[(i + 1) % face.size()], false, static_cast<int>(f),
+               model.faces_[f].name);
     }
+  }
+  for (ModelEdge& edge : model.edges_) {
+    if (edge.name.empty()) edge.name = JoinedNames(face_names_of_edge[edge.id]);
   }
   if (degenerate > 0) {
     model.warnings_.push_back(
         Located(model.path_, 0, std::to_string(degenerate) + " zero-length edges skipped"));
-  }
-
-  int degenerate_faces = 0;
-  for (const std::vector<int>& points : cao.faces) {
-    ModelFace face;
-    for (int p : points) {
-      face.vertices.push_back(vertex_of_point[p]);
-      face.corners.push_back(model.vertices_[vertex_of_point[p]]);
-    }
-    const Eigen::Vector3d n = NewellNormal(face.corners);
-    double extent = 0.0;
-    for (const Eigen::Vector3d& c : face.corners)
-      extent = std::max(extent, (c - face.corners[0]).norm());
-    if (n.norm() > 1e-9 * std::max(1.0, extent * extent)) {
-      face.normal = n.normalized();
-      face.offset = face.normal.dot(face.corners[0]);
-      face.vertical = std::abs(face.normal.z()) < 1e-6;
-      face.horizontal = std::abs(std::abs(face.normal.z()) - 1.0) < 1e-9;
-    } else {
-      ++degenerate_faces;
-    }
-    model.faces_.push_back(std::move(face));
   }
   if (degenerate_faces > 0) {
     model.warnings_.push_back(

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generates models/hall.cao and models/room.cao (ViSP .cao V1).
+"""Generates models/hall.cao, models/room.cao and models/office.cao (ViSP .cao V1).
 
 Faces follow ViSP's orientation: the right-hand rule on the vertex order gives the normal of the
 visible side (into the hall for walls, outwards for pillars). Doors and windows are 3D lines on
@@ -105,6 +105,62 @@ def room():
     m.write("models/room.cao")
 
 
+def recessed_door(m, x0, x1, y, depth, h, name):
+    """A door set back `depth` metres into a wall at y that faces -y (the wall's face must leave
+    the opening out): two reveal faces, the soffit and the door leaf, all visible from -y."""
+    yb = y + depth
+    m.face([(x0, y, 0), (x0, yb, 0), (x0, yb, h), (x0, y, h)], f"{name}_reveal_a")
+    m.face([(x1, yb, 0), (x1, y, 0), (x1, y, h), (x1, yb, h)], f"{name}_reveal_b")
+    m.face([(x0, y, h), (x0, yb, h), (x1, yb, h), (x1, y, h)], f"{name}_soffit")
+    m.face([(x0, yb, 0), (x1, yb, 0), (x1, yb, h), (x0, yb, h)], f"{name}_leaf")
+
+
+def office():
+    m = Cao("Office floor, 32 m x 14 m x 2.6 m: a ring corridor around a block of offices, "
+            "a lobby with two pillars and a desk; 28 doors")
+    h, door_h, door_w = 2.6, 2.05, 0.9
+    # Outer walls, normals inwards.
+    m.room(0, 0, 32, 14, h, "wall")
+    # The block of offices in the middle (x 2.2-24, y 2.2-11.8), normals outwards. Its south face
+    # leaves out the openings of two recessed doors.
+    cx0, cy0, cx1, cy1 = 2.2, 2.2, 24.0, 11.8
+    recesses = [(9.5, 9.5 + door_w), (16.5, 16.5 + door_w)]
+    south = [(cx0, cy0, 0)]
+    for a, b in recesses:
+        south += [(a, cy0, 0), (a, cy0, door_h), (b, cy0, door_h), (b, cy0, 0)]
+    south += [(cx1, cy0, 0), (cx1, cy0, h), (cx0, cy0, h)]
+    m.face(south, "offices_s")
+    m.box(cx0, cy0, cx1, cy1, h, "offices", sides=("e", "n", "w"))
+    for k, (a, b) in enumerate(recesses):
+        recessed_door(m, a, b, cy0, 0.15, door_h, f"door_offices_s{k}")
+    # Flush doors: jambs and lintel as 3D lines on the walls (the casings are not modelled).
+    for k, x in enumerate([3.5, 7.0, 10.5, 14.0, 17.5, 21.0]):
+        m.door((x, 0), (x + door_w, 0), door_h, f"door_south{k}")
+    for k, x in enumerate([4.5, 8.0, 11.5, 15.0, 18.5]):
+        m.door((x + door_w, 14), (x, 14), door_h, f"door_north{k}")
+    for k, y in enumerate([5.0, 8.5]):
+        m.door((0, y + door_w), (0, y), door_h, f"door_west{k}")
+    for k, x in enumerate([5.0, 13.0, 20.5]):
+        m.door((x, cy0), (x + door_w, cy0), door_h, f"door_offices_s{k + 2}")
+    for k, x in enumerate([3.5, 6.5, 10.0, 13.5, 20.0]):
+        m.door((x + door_w, cy1), (x, cy1), door_h, f"door_offices_n{k}")
+    m.door((cx0, 6.5 + door_w), (cx0, 6.5), door_h, "door_offices_w")
+    m.door((cx1, 6.4), (cx1, 7.9), 2.2, "door_offices_e")  # double door onto the lobby
+    # Lobby (x 24-32): doors south and north, the entrance east between windows.
+    m.door((26.5, 0), (26.5 + door_w, 0), door_h, "door_lobby_south")
+    m.door((29.6, 14), (28.7, 14), door_h, "door_lobby_north")
+    m.door((32, 6.4), (32, 7.9), 2.2, "entrance")
+    m.window((32, 2.0), (32, 5.0), 0.9, 2.2, "window_east_a")
+    m.window((32, 9.3), (32, 12.3), 0.9, 2.2, "window_east_b")
+    m.box(27.75, 4.25, 28.25, 4.75, h, "pillar_a")
+    m.box(27.75, 9.25, 28.25, 9.75, h, "pillar_b")
+    # Reception desk, 1.1 m high, with its top.
+    m.box(29.0, 6.2, 30.2, 7.6, 1.1, "desk")
+    m.face([(29.0, 6.2, 1.1), (30.2, 6.2, 1.1), (30.2, 7.6, 1.1), (29.0, 7.6, 1.1)], "desk_top")
+    m.write("models/office.cao")
+
+
 if __name__ == "__main__":
     hall()
     room()
+    office()

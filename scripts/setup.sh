@@ -12,6 +12,11 @@ packages=(
   libaravis-dev libusb-1.0-0-dev aravis-tools
   googletest libgtest-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libyaml-cpp-dev
+  ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-geometry-msgs-dev
+  libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
+  libimage-transport-dev libcv-bridge-dev libdiagnostic-updater-dev
+  libassimp-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -6,6 +6,7 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/statistics.h"
+#include "tracking/head/head_pointing.h"
 #include "tracking/sim/sim_rig.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -92,9 +93,9 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
   SimCameraOptions sim;
   sim.fps = options.fps;
   sim.render = options.render;
-  sim.head_model = options.servo.model;
   LiveLoopOptions loop;
   loop.servo = options.servo;
+  loop.crossing_height = CrossingHeightFor(loop.servo.geometry, sim.camera_height);
   // A fresh tracker per run (null: the simulator's truth).
   auto MakeTracker = [&]() -> std::unique_ptr<TrackerPoseEstimator> {
     if (!options.use_tracker) return nullptr;
@@ -108,8 +109,10 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d(options.start_pan_offset, options.start_tilt_offset);
     const auto tracker = MakeTracker();
-    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter, tracker.get());
+    SimulatedLiveRig rig(
+        model, &area, camera,
+        SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, loop, start, options.jitter},
+        tracker.get());
     runs.push_back(RunOne("still", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.still_seconds * options.fps)),
                           options.still_seconds / 2));
@@ -120,8 +123,10 @@ std::vector<ServoBenchRun> RunServoBench(const WireframeModel& model, const Navi
     SimHeadStart start;
     start.offset_from_target = Eigen::Vector2d::Zero();
     const auto tracker = MakeTracker();
-    SimulatedLiveRig rig(model, &area, camera, sim, SimulatedHeadOptions{}, loop, start,
-                         options.jitter, tracker.get());
+    SimulatedLiveRig rig(
+        model, &area, camera,
+        SimulatedLiveRigOptions{sim, SimulatedHeadOptions{}, loop, start, options.jitter},
+        tracker.get());
     runs.push_back(RunOne("drive", &rig, tracker.get(),
                           static_cast<int>(std::lround(options.drive_seconds * options.fps)),
                           options.settle_seconds));

@@ -113,7 +113,14 @@ void AddBenchCapture(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--fake-serial", opt->fake_serial, "Serial number of the fake camera")
       ->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print one JSON object");
-  cmd->callback([opt, action] { *action = [opt] { return RunBenchCapture(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnless(*cmd, opt->source.empty() || opt->source.rfind("aravis", 0) == 0,
+                 {"--width", "--height", "--fps", "--pixel-format", "--buffers"},
+                 "applies to Aravis cameras (--source aravis[:ID] or the fake camera)");
+    RefuseUnless(*cmd, opt->source.empty(), {"--fake-serial"},
+                 "applies to the fake camera (without --source)");
+    *action = [opt] { return RunBenchCapture(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/heading/heading_estimator.h"
 #include "matching/lines/line_extractor.h"
@@ -180,7 +181,7 @@ int RunBenchHeading(const BenchHeadingOptions& opt) {
   if (!ParseLineDetector(opt.detector))
     throw InputError("--detector: unknown '" + opt.detector + "'");
   cv::setNumThreads(1);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const ModelDirections dirs = DominantDirections(model);
   CameraIntrinsics camera = PaperSyntheticCamera();

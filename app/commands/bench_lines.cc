@@ -18,6 +18,7 @@
 
 #include "app/commands.h"
 #include "app/image_overlay.h"
+#include "app/model_loading.h"
 #include "app/rendered_cases.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -27,7 +28,7 @@
 namespace linetrack::app {
 namespace {
 
-// Visible model edges projecting at least this long must be found (issue 4).
+// Visible model edges projecting at least this long must be found.
 constexpr double kMinEdgeLengthPx = 40.0;
 
 struct BenchLinesOptions {
@@ -77,16 +78,23 @@ CameraIntrinsics WideCamera() {
   return camera;
 }
 
-FrameSet RenderedSet(const std::string& name, const CameraIntrinsics& camera, int max_edges,
-                     const WireframeModel& model, const NavigableArea& area,
-                     const OcclusionTester& occlusion, const BenchLinesOptions& opt) {
+// The rendered views of a set: the benchmark's count, seed and clutter, seen by `camera`, each
+// showing at most `max_edges` model edges.
+RenderedCaseOptions SetOptions(const BenchLinesOptions& opt, const CameraIntrinsics& camera,
+                               int max_edges) {
   RenderedCaseOptions options;
   options.count = opt.rendered;
   options.seed = opt.seed;
   options.camera = camera;
   options.clutter = opt.clutter;
   options.max_visible_edges = max_edges;
-  FrameSet set{name, camera, {}, {}, {}};
+  return options;
+}
+
+FrameSet RenderedSet(const std::string& name, const RenderedCaseOptions& options,
+                     const WireframeModel& model, const NavigableArea& area,
+                     const OcclusionTester& occlusion) {
+  FrameSet set{name, options.camera, {}, {}, {}};
   for (RenderedCase& c : RenderCases(model, area, occlusion, options)) {
     set.images.push_back(std::move(c.image));
     set.truth.push_back(std::move(c.truth));
@@ -208,16 +216,16 @@ int RunBenchLines(const BenchLinesOptions& opt) {
     detectors.push_back(*kind);
   }
   cv::setNumThreads(1);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const OcclusionTester occlusion(model);
 
   std::vector<FrameSet> sets;
   spdlog::info("rendering {} hall views per camera", opt.rendered);
-  sets.push_back(RenderedSet("hall rendered, px 1000", PaperSyntheticCamera(), 12, model, area,
-                             occlusion, opt));
-  sets.push_back(RenderedSet("hall rendered, px 500 + distortion", WideCamera(), 40, model, area,
-                             occlusion, opt));
+  sets.push_back(RenderedSet("hall rendered, px 1000", SetOptions(opt, PaperSyntheticCamera(), 12),
+                             model, area, occlusion));
+  sets.push_back(RenderedSet("hall rendered, px 500 + distortion",
+                             SetOptions(opt, WideCamera(), 40), model, area, occlusion));
   const std::string cube = opt.visp_images + "/mbt/cube";
   const std::string castle = opt.visp_images + "/mbt-depth/Castle-simu/Images";
   for (const auto& [name, dir, ext] : {std::tuple{"ViSP mbt/cube", cube, ".pgm"},

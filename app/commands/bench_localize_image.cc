@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/localize_image.h"
 #include "app/match_outcome.h"
+#include "app/model_loading.h"
 #include "app/rendered_cases.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/lines/line_extractor.h"
@@ -110,16 +111,97 @@ FailureCause Attribute(const RenderedCase& c, const std::vector<Segment2>& lines
              : FailureCause::kDetector;
 }
 
-int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
-  const auto detector = ParseLineDetector(opt.detector);
-  if (!detector) throw InputError("--detector: unknown detector '" + opt.detector + "'");
-  const PriorBounds bounds = QualityIndexBounds(opt.qi);
-  cv::setNumThreads(1);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
-  const NavigableArea area = NavigableArea::FromModel(model);
-  const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
-  const OcclusionTester occlusion(model);
+// Outcomes, causes and figures over the images.
+struct ImageTally {
+  int counts[4] = {0, 0, 0, 0};
+  int causes[3] = {0, 0, 0};  // failures (not correct) by cause
+  std::vector<double> lines_ms, matcher_ms, total_ms, segments, position_error, heading_error;
+  int accurate = 0;  // poses (any correspondences) within the paper's real-image accuracy
+  std::ostringstream failures;
+};
 
+// Extracts the lines of case `i`, localises, judges the answer and, when it is not correct,
+// finds whose failure it is.
+void TallyCase(size_t i, const RenderedCase& c, LineExtractor& extractor,
+               const Localizer& localizer, ImageTally* tally) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<Segment2> lines = extractor(c.image);
+  const auto t1 = std::chrono::steady_clock::now();
+  LocalizationResult result;
+  if (!lines.empty()) result = localizer.Localize(Problem(c, lines));
+  const auto t2 = std::chrono::steady_clock::now();
+  tally->lines_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  tally->matcher_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+  tally->total_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
+  tally->segments.push_back(lines.size());
+  const Outcome outcome = Judge(c, result, TrueCorrespondences(c.truth, lines, {}));
+  ++tally->counts[static_cast<int>(outcome)];
+  const double position_error =
+      std::hypot(result.pose.x - c.scene.truth.x, result.pose.y - c.scene.truth.y);
+  const double heading_error =
+      RadToDeg(std::abs(WrapAngle(result.pose.heading - c.scene.truth.heading)));
+  if (result.found && position_error <= kPaperPositionM && heading_error <= kPaperHeadingDeg) {
+    ++tally->accurate;
+  }
+  if (outcome == Outcome::kCorrect) {
+    tally->position_error.push_back(position_error);
+    tally->heading_error.push_back(heading_error);
+    return;
+  }
+  // Whose failure: the matcher given the exact visible pieces, then only the detections
+  // that image model edges (no clutter, no frame bands).
+  const FailureCause cause = Attribute(c, lines, localizer);
+  ++tally->causes[static_cast<int>(cause)];
+  const DetectionEvaluation found = EvaluateDetections(c.observable, lines, kMinEdgeLengthPx, {});
+  tally->failures << "| " << i << " | " << MatchOutcomeName(outcome) << " | " << found.found
+                  << " / " << found.edges.size() << " | " << kCauseNames[static_cast<int>(cause)]
+                  << " | " << (result.found ? "" : result.reason) << " |\n";
+}
+
+// The Markdown report: the set-up, the outcome table, the causes and the failures.
+std::string ImageTable(const BenchLocalizeImageOptions& opt, const PriorBounds& bounds,
+                       const LineNoise& noise, size_t cases, const ImageTally& t) {
+  const double n = std::max<size_t>(1, cases);
+  std::ostringstream table;
+  table << std::fixed << cases << " rendered hall views ("
+        << (opt.camera_path.empty() ? "the paper's camera, 640x480, px 1000" : opt.camera_path)
+        << ", " << opt.clutter << " clutter objects, seed " << opt.seed << "), poses and QI"
+        << opt.qi << " priors (" << std::setprecision(2) << bounds.delta_t << " m, "
+        << std::setprecision(0) << RadToDeg(bounds.delta_phi)
+        << " deg) drawn as linetrack synth draws them, calibration "
+        << "error sigma " << std::setprecision(3) << opt.calibration_sigma
+        << "; matcher set for detected lines (DetectedLineNoise): line noise "
+        << std::setprecision(1) << noise.offset_px << " px, " << noise.angle_deg
+        << " deg; focal error " << std::setprecision(3) << opt.focal_error << "; detector "
+        << opt.detector << ", one thread.\n\n"
+        << "| correct | no answer | wrong but accurate | wrong | pose within 0.2 m, 3 deg | "
+           "lines ms (median / p90) | "
+           "matcher ms (median / p90) | total ms (median / p90) | segments (median) | pose "
+           "error of correct answers (median) |\n"
+        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+        << "| " << t.counts[0] << " (" << std::setprecision(1) << 100.0 * t.counts[0] / n
+        << " %) | " << t.counts[1] << " | " << t.counts[2] << " | " << t.counts[3] << " | "
+        << t.accurate << " (" << 100.0 * t.accurate / n << " %) | " << std::setprecision(2)
+        << QuantileNearestRank(t.lines_ms, 0.5) << " / " << QuantileNearestRank(t.lines_ms, 0.9)
+        << " | " << QuantileNearestRank(t.matcher_ms, 0.5) << " / "
+        << QuantileNearestRank(t.matcher_ms, 0.9) << " | " << QuantileNearestRank(t.total_ms, 0.5)
+        << " / " << QuantileNearestRank(t.total_ms, 0.9) << " | " << std::setprecision(0)
+        << QuantileNearestRank(t.segments, 0.5) << " | " << std::setprecision(3)
+        << QuantileNearestRank(t.position_error, 0.5) << " m, " << std::setprecision(2)
+        << QuantileNearestRank(t.heading_error, 0.5) << " deg |\n\n"
+        << "Not correct: " << t.causes[0] + t.causes[1] + t.causes[2]
+        << "; by cause: " << t.causes[0] << " " << kCauseNames[0] << ", " << t.causes[1] << " "
+        << kCauseNames[1] << ", " << t.causes[2] << " " << kCauseNames[2] << ".\n";
+  if (t.causes[0] + t.causes[1] + t.causes[2] > 0) {
+    table << "\n| case | outcome | observable edges >= 40 px found | cause | reason |\n"
+             "| --- | --- | --- | --- | --- |\n"
+          << t.failures.str();
+  }
+  return table.str();
+}
+
+// The rendering of the cases: the benchmark's flags in RenderedCaseOptions.
+RenderedCaseOptions CaseOptions(const BenchLocalizeImageOptions& opt, const PriorBounds& bounds) {
   RenderedCaseOptions case_options;
   case_options.count = opt.count;
   case_options.seed = opt.seed;
@@ -127,13 +209,26 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   case_options.calibration_sigma = opt.calibration_sigma;
   case_options.max_visible_edges = opt.max_edges;
   if (!opt.camera_path.empty()) {
-    case_options.camera = ReadCameraXml(opt.camera_path);
+    case_options.camera = LoadCamera(opt.camera_path);
     if (case_options.camera.width <= 0) {
       throw InputError(opt.camera_path + ": the camera file gives no image size");
     }
   }
   case_options.delta_t = bounds.delta_t;
   case_options.delta_phi = bounds.delta_phi;
+  return case_options;
+}
+
+int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
+  const auto detector = ParseLineDetector(opt.detector);
+  if (!detector) throw InputError("--detector: unknown detector '" + opt.detector + "'");
+  const PriorBounds bounds = QualityIndexBounds(opt.qi);
+  cv::setNumThreads(1);
+  const WireframeModel model = LoadModel(opt.model_path);
+  const NavigableArea area = NavigableArea::FromModel(model);
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
+  const OcclusionTester occlusion(model);
+  const RenderedCaseOptions case_options = CaseOptions(opt, bounds);
   spdlog::info("rendering {} hall views", opt.count);
   const std::vector<RenderedCase> cases = RenderCases(model, area, occlusion, case_options);
 
@@ -144,89 +239,14 @@ int RunBenchLocalizeImage(const BenchLocalizeImageOptions& opt) {
   localizer_options.noise = DetectedLineNoise();
   localizer_options.noise.focal_relative = opt.focal_error;
   const Localizer localizer(model, &regions, &area, case_options.camera, localizer_options);
-
-  int counts[4] = {0, 0, 0, 0};
-  int causes[3] = {0, 0, 0};  // failures (not correct) by cause
-  std::vector<double> lines_ms, matcher_ms, total_ms, segments, position_error, heading_error;
-  int accurate = 0;  // poses (any correspondences) within the paper's real-image accuracy
-  std::ostringstream failures;
+  ImageTally tally;
   for (size_t i = 0; i < cases.size(); ++i) {
-    const RenderedCase& c = cases[i];
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<Segment2> lines = extractor(c.image);
-    const auto t1 = std::chrono::steady_clock::now();
-    LocalizationResult result;
-    if (!lines.empty()) result = localizer.Localize(Problem(c, lines));
-    const auto t2 = std::chrono::steady_clock::now();
-    lines_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    matcher_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
-    total_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
-    segments.push_back(lines.size());
-    const Outcome outcome = Judge(c, result, TrueCorrespondences(c.truth, lines, {}));
-    ++counts[static_cast<int>(outcome)];
-    if (result.found &&
-        std::hypot(result.pose.x - c.scene.truth.x, result.pose.y - c.scene.truth.y) <=
-            kPaperPositionM &&
-        RadToDeg(std::abs(WrapAngle(result.pose.heading - c.scene.truth.heading))) <=
-            kPaperHeadingDeg) {
-      ++accurate;
-    }
-    if (outcome == Outcome::kCorrect) {
-      position_error.push_back(
-          std::hypot(result.pose.x - c.scene.truth.x, result.pose.y - c.scene.truth.y));
-      heading_error.push_back(
-          RadToDeg(std::abs(WrapAngle(result.pose.heading - c.scene.truth.heading))));
-    }
-    if (outcome == Outcome::kCorrect) continue;
-    // Whose failure: the matcher given the exact visible pieces, then only the detections
-    // that image model edges (no clutter, no frame bands).
-    const FailureCause cause = Attribute(c, lines, localizer);
-    ++causes[static_cast<int>(cause)];
-    const DetectionEvaluation found = EvaluateDetections(c.observable, lines, kMinEdgeLengthPx, {});
-    failures << "| " << i << " | " << MatchOutcomeName(outcome) << " | " << found.found << " / "
-             << found.edges.size() << " | " << kCauseNames[static_cast<int>(cause)] << " | "
-             << (result.found ? "" : result.reason) << " |\n";
+    TallyCase(i, cases[i], extractor, localizer, &tally);
     if ((i + 1) % 50 == 0) spdlog::info("{}/{} images", i + 1, cases.size());
   }
-
-  const double n = std::max<size_t>(1, cases.size());
-  std::ostringstream table;
-  table << std::fixed << cases.size() << " rendered hall views ("
-        << (opt.camera_path.empty() ? "the paper's camera, 640x480, px 1000" : opt.camera_path)
-        << ", " << opt.clutter << " clutter objects, seed " << opt.seed << "), poses and QI"
-        << opt.qi << " priors (" << std::setprecision(2) << bounds.delta_t << " m, "
-        << std::setprecision(0) << RadToDeg(bounds.delta_phi)
-        << " deg) drawn as linetrack synth draws them, calibration "
-        << "error sigma " << std::setprecision(3) << opt.calibration_sigma
-        << "; matcher set for detected lines (DetectedLineNoise): line noise "
-        << std::setprecision(1) << localizer_options.noise.offset_px << " px, "
-        << localizer_options.noise.angle_deg << " deg; focal error " << std::setprecision(3)
-        << opt.focal_error << "; detector " << opt.detector << ", one thread.\n\n"
-        << "| correct | no answer | wrong but accurate | wrong | pose within 0.2 m, 3 deg | "
-           "lines ms (median / p90) | "
-           "matcher ms (median / p90) | total ms (median / p90) | segments (median) | pose "
-           "error of correct answers (median) |\n"
-        << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
-        << "| " << counts[0] << " (" << std::setprecision(1) << 100.0 * counts[0] / n << " %) | "
-        << counts[1] << " | " << counts[2] << " | " << counts[3] << " | " << accurate << " ("
-        << 100.0 * accurate / n << " %) | " << std::setprecision(2)
-        << QuantileNearestRank(lines_ms, 0.5) << " / " << QuantileNearestRank(lines_ms, 0.9)
-        << " | " << QuantileNearestRank(matcher_ms, 0.5) << " / "
-        << QuantileNearestRank(matcher_ms, 0.9) << " | " << QuantileNearestRank(total_ms, 0.5)
-        << " / " << QuantileNearestRank(total_ms, 0.9) << " | " << std::setprecision(0)
-        << QuantileNearestRank(segments, 0.5) << " | " << std::setprecision(3)
-        << QuantileNearestRank(position_error, 0.5) << " m, " << std::setprecision(2)
-        << QuantileNearestRank(heading_error, 0.5) << " deg |\n\n"
-        << "Not correct: " << causes[0] + causes[1] + causes[2] << "; by cause: " << causes[0]
-        << " " << kCauseNames[0] << ", " << causes[1] << " " << kCauseNames[1] << ", " << causes[2]
-        << " " << kCauseNames[2] << ".\n";
-  if (causes[0] + causes[1] + causes[2] > 0) {
-    table << "\n| case | outcome | observable edges >= 40 px found | cause | reason |\n"
-             "| --- | --- | --- | --- | --- |\n"
-          << failures.str();
-  }
-  std::cout << table.str();
-  if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, table.str());
+  const std::string table = ImageTable(opt, bounds, localizer_options.noise, cases.size(), tally);
+  std::cout << table;
+  if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, table);
   return kExitOk;
 }
 
@@ -253,7 +273,8 @@ void AddBenchLocalizeImage(CLI::App& cli, CommandAction* action) {
                   "Relative focal-length uncertainty the matcher allows (localize --focal-error)")
       ->capture_default_str();
   cmd->add_option("--camera", opt->camera_path,
-                  "Camera XML of the images (default: the paper's 640x480, px = 1000)");
+                  "Camera file of the images: ViSP XML, OpenCV or ROS YAML (default: the paper's "
+                  "640x480, px = 1000)");
   cmd->add_option("--max-edges", opt->max_edges,
                   "Views show 5 to this many model edges (synth's acceptance; wider lenses see "
                   "more)")

@@ -15,6 +15,7 @@
 
 #include "app/commands.h"
 #include "app/match_outcome.h"
+#include "app/model_loading.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/evaluation/diagnosis.h"
 #include "matching/global/global_localizer.h"
@@ -49,6 +50,7 @@ struct BenchMatchOptions {
   int parallel_clutter = 0;  // near-parallel unmodelled lines per scene (synth's option)
   std::string out_path;
   std::string diagnose_path;  // JSON lines: every scene the tree does not answer correctly
+  bool verbose = false;       // also the developer's table: the doubted groups' posterior
   std::vector<int> only;      // when not empty: run these scene indices only (debugging)
 };
 
@@ -79,11 +81,7 @@ PoseErrors AnswerErrors(const SyntheticScene& scene, const LocalizationResult& r
 
 Outcome Judge(const SyntheticScene& scene, const LocalizationResult& result,
               const PoseErrors& errors) {
-  const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
-  const bool all_true =
-      !result.matches.empty() && std::all_of(result.matches.begin(), result.matches.end(),
-                                             [&](const auto& m) { return truth.count(m) > 0; });
-  return JudgeMatch(result.found, all_true, errors);
+  return JudgeMatch(result.found, ReportedMatchesTrue(scene.matches, result.matches), errors);
 }
 
 Outcome Score(const SyntheticScene& scene, const LocalizationResult& result, double ms,
@@ -128,10 +126,12 @@ std::string Classify(const TruthDiagnosis& d, const LocalizationResult& result) 
 
 nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const LocalizationResult& result,
                                      Outcome outcome, const TruthDiagnosis& d,
-                                     const std::string& category) {
+                                     const std::string& category, const WireframeModel& model) {
+  auto name = [&model](int edge) { return model.edges().at(static_cast<size_t>(edge)).name; };
   nlohmann::ordered_json pairs = nlohmann::ordered_json::array();
   for (const TruthPairCheck& p : d.pairs) {
     pairs.push_back({{"edge", p.edge_id},
+                     {"name", name(p.edge_id)},
                      {"line", p.line},
                      {"vertical", p.vertical},
                      {"candidate", p.candidate},
@@ -142,8 +142,11 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
   }
   const std::set<std::pair<int, int>> truth(scene.matches.begin(), scene.matches.end());
   nlohmann::ordered_json wrong = nlohmann::ordered_json::array();
+  nlohmann::ordered_json wrong_names = nlohmann::ordered_json::array();
   for (const auto& m : result.matches) {
-    if (!truth.count(m)) wrong.push_back({m.first, m.second});
+    if (truth.count(m)) continue;
+    wrong.push_back({m.first, m.second});
+    wrong_names.push_back(name(m.first));
   }
   int pose_false_pairs = 0;  // pairs of the accepted pose's interpretation, reported or not
   if (!result.finalists.empty()) {
@@ -168,6 +171,7 @@ nlohmann::ordered_json DiagnosisJson(const SyntheticScene& scene, const Localiza
           {"unexplained_completed_bound", result.unexplained_completed_bound},
           {"pose_error", {errors.position_m, errors.heading_deg}},
           {"wrong_matches", wrong},
+          {"wrong_match_names", wrong_names},
           {"pose_false_pairs", pose_false_pairs},
           {"truth_mahalanobis2", errors.mahalanobis2},
           {"true_edges", d.true_edges},
@@ -309,17 +313,8 @@ std::string GlobalRow(const Localizer& tree, const ModelDirections& directions,
   return "| " + name + " " + Row("heading + tree", t) + "\n";
 }
 
-int RunBenchMatch(const BenchMatchOptions& opt) {
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
-  const NavigableArea area = NavigableArea::FromModel(model);
-  const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
-  const ModelDirections directions = DominantDirections(model);
-  std::vector<Series> series;
-  for (const std::string& name : opt.series)
-    series.push_back(SeriesByName(name));
-
-  std::unique_ptr<std::ostringstream> diagnosis;
-  if (!opt.diagnose_path.empty()) diagnosis = std::make_unique<std::ostringstream>();
+// The set-up line and the head of the table.
+std::string TableHeader(const BenchMatchOptions& opt) {
   std::ostringstream table;
   table << "Synthetic scenes of the paper's section 4.1 on " << opt.model_path << " (" << opt.count
         << " per series, seed " << opt.seed
@@ -332,16 +327,38 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
            "hypotheses verified (median / max) | time ms (median / p99) | pose error of "
            "correct answers (median) |\n"
         << "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  return table.str();
+}
+
+// The scenes of one series.
+SyntheticSceneOptions SceneOptions(const BenchMatchOptions& opt, const Series& s) {
+  SyntheticSceneOptions scene_options;
+  scene_options.seed = opt.seed;
+  scene_options.count = opt.count;
+  scene_options.delta_t = s.delta_t;
+  scene_options.delta_phi = DegToRad(s.delta_phi);
+  if (opt.clutter > 0) scene_options.min_clutter = scene_options.max_clutter = opt.clutter;
+  scene_options.parallel_clutter = opt.parallel_clutter;
+  return scene_options;
+}
+
+int RunBenchMatch(const BenchMatchOptions& opt) {
+  const WireframeModel model = LoadModel(opt.model_path);
+  const NavigableArea area = NavigableArea::FromModel(model);
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
+  const ModelDirections directions = DominantDirections(model);
+  std::vector<Series> series;
+  for (const std::string& name : opt.series)
+    series.push_back(SeriesByName(name));
+
+  std::unique_ptr<std::ostringstream> diagnosis;
+  if (!opt.diagnose_path.empty()) diagnosis = std::make_unique<std::ostringstream>();
+  std::ostringstream table;
+  table << TableHeader(opt);
   std::ostringstream beyond;  // correct answers accurate only by their own confidence region
   DoubtCalibration calibration;
   for (const Series& s : series) {
-    SyntheticSceneOptions scene_options;
-    scene_options.seed = opt.seed;
-    scene_options.count = opt.count;
-    scene_options.delta_t = s.delta_t;
-    scene_options.delta_phi = DegToRad(s.delta_phi);
-    if (opt.clutter > 0) scene_options.min_clutter = scene_options.max_clutter = opt.clutter;
-    scene_options.parallel_clutter = opt.parallel_clutter;
+    const SyntheticSceneOptions scene_options = SceneOptions(opt, s);
     spdlog::info("{}: generating {} scenes", s.name, opt.count);
     const std::vector<SyntheticScene> scenes = GenerateScenes(model, area, scene_options);
 
@@ -379,7 +396,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
               DiagnoseTruth(tree, problem, scene.truth.Planar(), scene.matches);
           const std::string category = Classify(d, result);
           ++categories[category];
-          nlohmann::ordered_json j = DiagnosisJson(scene, result, outcome, d, category);
+          nlohmann::ordered_json j = DiagnosisJson(scene, result, outcome, d, category, model);
           j["series"] = s.name;
           *diagnosis << j.dump() << "\n";
         } else if (m == 0 && diagnosis && result.budget_exhausted) {
@@ -409,7 +426,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
         << " deg of the truth, or the truth inside the answer's own 99.9 % confidence region "
            "(its covariance). Correct by that region only (farther than the tolerance): "
         << beyond.str() << ".\n";
-  table << calibration.Table();
+  if (opt.verbose) table << calibration.Table();
   std::cout << table.str();
   if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, table.str());
   if (diagnosis) WriteFileAtomically(opt.diagnose_path, diagnosis->str());
@@ -443,15 +460,19 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
                   "Write a JSON line per scene the tree does not answer correctly: where the "
                   "true correspondences are lost (matching/evaluation/diagnosis.h); and a short "
                   "one per correct answer whose search budget ran out");
+  cmd->add_flag("--verbose", opt->verbose,
+                "Also print the developer's table: the posterior of the doubted unreported "
+                "groups against the truth");
   cmd->add_option("--only", opt->only,
                   "Run only these scene indices (0-based, of the --count generated; debugging)")
       ->delimiter(',');
-  cmd->callback([opt, action] {
+  cmd->callback([opt, action, cmd] {
     if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
     if (opt->clutter < 0) throw CLI::ValidationError("--clutter", "must be at least 0");
     if (opt->parallel_clutter < 0) {
       throw CLI::ValidationError("--parallel-clutter", "must be at least 0");
     }
+    RefuseUnless(*cmd, opt->baseline, {"--baseline-samples"}, "not with --no-baseline");
     *action = [opt] { return RunBenchMatch(*opt); };
   });
 }

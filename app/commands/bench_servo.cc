@@ -10,6 +10,7 @@
 #include "app/bench/servo_bench.h"
 #include "app/commands.h"
 #include "app/localize_image.h"
+#include "app/model_loading.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -71,10 +72,10 @@ int RunBenchServo(BenchServoCommandOptions opt) {
   if (!opt.settings.empty()) opt.bench.tracker.settings = ReadTrackerSettings(opt.settings);
   std::string why;
   if (!opt.bench.Check(&why)) throw InputError("bench servo: " + why);
-  const CameraIntrinsics camera = ReadCameraXml(opt.camera_path);
+  const CameraIntrinsics camera = LoadCamera(opt.camera_path);
   if (camera.width <= 0)
     throw InputError(opt.camera_path + ": the camera file gives no image size");
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   NavigableAreaOptions area_options;
   area_options.sidecar_path = opt.nav_path;
   const NavigableArea area = NavigableArea::FromModel(model, area_options);
@@ -133,7 +134,9 @@ void AddBenchServo(CLI::App& cli, CommandAction* action) {
       "The live loop on the simulator: time per iteration excluding capture (tracker included), "
       "convergence from a 10/5 degree offset, target error while the robot drives the loop");
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
-  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (frame size)")->required();
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (frame size)")
+      ->required();
   cmd->add_option("--nav", opt->nav_path, "Navigable-area file (default: MODEL.nav.json)");
   cmd->add_option("--fps", opt->bench.fps, "Simulated frames per second")->capture_default_str();
   cmd->add_option("--still-seconds", opt->bench.still_seconds, "Length of the convergence run")
@@ -154,7 +157,13 @@ void AddBenchServo(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
   cmd->add_flag("--json", opt->json, "Print JSON");
-  cmd->callback([opt, action] { *action = [opt] { return RunBenchServo(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnless(*cmd, opt->estimator != "truth", {"--settings"},
+                 "the tracker's settings; --estimator truth uses no tracker");
+    RefuseUnless(*cmd, opt->estimator == "truth", {"--jitter-deg", "--jitter-m"},
+                 "noise on the simulator's poses, with --estimator truth");
+    *action = [opt] { return RunBenchServo(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "app/rendered_key_view.h"
 #include "matching/evaluation/line_evaluation.h"
 #include "matching/views/view_positioning.h"
@@ -289,7 +290,7 @@ std::string SweepTable() {
 
 int RunBenchViews(const BenchViewsOptions& opt) {
   cv::setNumThreads(1);
-  Setup s{WireframeModel::Load(opt.model_path), NavigableArea(), PaperSyntheticCamera(), {}};
+  Setup s{LoadModel(opt.model_path), NavigableArea(), PaperSyntheticCamera(), {}};
   s.area = NavigableArea::FromModel(s.model);
   if (!opt.camera_path.empty()) s.camera = ReadCameraXml(opt.camera_path);
   if (s.camera.width <= 0)

@@ -1,7 +1,6 @@
 // `linetrack calibrate`: camera calibration from image files or a frame source (Zhang's method
 // through ViSP, OpenCV's model beside it), and `linetrack bench calibrate` (its timing).
 // docs/calibration.md.
-#include <glob.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/image_arguments.h"
 #include "calibration/output_files.h"
 #include "models/errors.h"
 #include "models/statistics.h"
@@ -38,34 +38,6 @@ struct CalibrateCommandOptions {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-bool HasGlobCharacters(const std::string& text) {
-  return text.find_first_of("*?[") != std::string::npos;
-}
-
-// Expands each argument as a glob (sorted matches); arguments without wildcards stay as they
-// are. Throws InputError for a wildcard pattern that matches no file.
-std::vector<std::string> ExpandImageArguments(const std::vector<std::string>& arguments) {
-  std::vector<std::string> paths;
-  for (const std::string& arg : arguments) {
-    if (!HasGlobCharacters(arg)) {
-      paths.push_back(arg);
-      continue;
-    }
-    glob_t matches{};
-    const int status = ::glob(arg.c_str(), 0, nullptr, &matches);
-    std::vector<std::string> found;
-    if (status == 0) {
-      for (size_t i = 0; i < matches.gl_pathc; ++i)
-        found.emplace_back(matches.gl_pathv[i]);
-    }
-    globfree(&matches);
-    if (found.empty()) throw InputError("--images: '" + arg + "' matches no file");
-    std::sort(found.begin(), found.end());
-    paths.insert(paths.end(), found.begin(), found.end());
-  }
-  return paths;
 }
 
 // Frames from a source (camera, video, sequence) where the pattern is found, up to opt.frames.
@@ -253,6 +225,15 @@ void AddCalibrationFlags(CLI::App* cmd, CalibrateCommandOptions* opt) {
   cmd->add_flag("--fix-k3", opt->calib.opencv.fix_k3, "OpenCV model: k3 = 0 (CALIB_FIX_K3)");
 }
 
+// Refuses the pattern and rejection flags that the chosen pattern or --keep-all leave unused.
+void RefuseUnusedCalibrationFlags(const CLI::App& cmd, const CalibrateCommandOptions& opt) {
+  RefuseUnless(cmd, opt.pattern == "charuco", {"--marker", "--dictionary"},
+               "applies to --pattern charuco");
+  RefuseUnless(cmd, opt.pattern == "chessboard", {"--sb"}, "applies to --pattern chessboard");
+  RefuseUnless(cmd, !opt.keep_all, {"--outlier-factor", "--outlier-min-error"},
+               "not with --keep-all (no view is rejected as an outlier)");
+}
+
 }  // namespace
 
 void AddCalibrate(CLI::App& cli, CommandAction* action) {
@@ -274,7 +255,12 @@ void AddCalibrate(CLI::App& cli, CommandAction* action) {
       ->required();
   cmd->add_option("--name", opt->camera_name, "Camera name in the XML and ROS files")
       ->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunCalibrate(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnusedCalibrationFlags(*cmd, *opt);
+    RefuseUnless(*cmd, !opt->source.empty(), {"--frames", "--max-grabs"},
+                 "applies to --source (frames grabbed until the pattern is seen)");
+    *action = [opt] { return RunCalibrate(*opt); };
+  });
 }
 
 void AddBenchCalibrate(CLI::App& cli, CommandAction* action) {
@@ -283,7 +269,10 @@ void AddBenchCalibrate(CLI::App& cli, CommandAction* action) {
       "calibrate", "Time of a whole calibration (detection + estimation), median of --repeat runs");
   AddCalibrationFlags(cmd, opt.get());
   cmd->add_option("--repeat", opt->repeat, "Runs")->capture_default_str();
-  cmd->callback([opt, action] { *action = [opt] { return RunBenchCalibrate(*opt); }; });
+  cmd->callback([opt, action, cmd] {
+    RefuseUnusedCalibrationFlags(*cmd, *opt);
+    *action = [opt] { return RunBenchCalibrate(*opt); };
+  });
 }
 
 }  // namespace linetrack::app

@@ -13,6 +13,7 @@
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "app/model_loading.h"
 #include "matching/heading/heading_estimator.h"
 #include "models/errors.h"
 
@@ -114,7 +115,7 @@ int RunHeading(const HeadingCommandOptions& opt) {
     throw InputError("heading: give either IMAGE or --lines");
   }
   if (opt.tilt_deg) CheckRange(*opt.tilt_deg, -89.0, 89.0, "--tilt");
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const ModelDirections directions = DominantDirections(model);
   if (directions.angles.empty()) throw InputError(opt.model_path + ": no horizontal edges");
   std::vector<Segment2> segments;

@@ -19,9 +19,11 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/integrity_output.h"
 #include "app/live_output.h"
 #include "app/live_session.h"
 #include "app/localize_image.h"
+#include "app/model_loading.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
 #include "models/geometry.h"
@@ -41,7 +43,7 @@ struct LiveCommandOptions {
   std::string head_start, head_start_offset;
   std::string head_model = "ptu46";
   std::string estimator = "auto";
-  std::string settings;
+  std::string settings, mount;
   double height = -1.0;
   double duration = 0.0;
   bool duration_given = false;  // without --duration: 10 s for the simulator, until stopped
@@ -49,6 +51,7 @@ struct LiveCommandOptions {
   bool display = false;
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
   double camera_fps = 0.0;
+  IntegrityFlags integrity;
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -98,8 +101,14 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   if (!ParseHeadModel(opt.head_model, &plan.head_model)) {
     throw InputError("--head-model: expected ptu46 or biclops, got '" + opt.head_model + "'");
   }
-  CheckRange(opt.height, 0.05, 100.0, "--height");
-  plan.height = opt.height;
+  if (opt.height < 0.0 && (opt.mount.empty() || plan.sim)) {
+    throw InputError("--height: needed (the camera height above the floor with the head level)");
+  }
+  if (opt.height >= 0.0) {
+    CheckHeight(opt.height, "--height");
+    CheckRange(opt.height, 0.05, 100.0, "--height");
+    plan.height = opt.height;
+  }
   if (!opt.prior.empty() && !opt.prior_file.empty()) {
     throw InputError("--prior and --prior-file: give one of them");
   }
@@ -127,7 +136,6 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   }
   if (opt.snapshot_every < 0) throw InputError("--snapshot-every: must be >= 0");
   CheckRange(opt.max_rate_deg, 0.1, 360.0, "--max-rate");
-  plan.loop.servo.model = plan.head_model;
   plan.loop.servo.max_pan_rate = plan.loop.servo.max_tilt_rate = DegToRad(opt.max_rate_deg);
   plan.duration = opt.duration_given ? opt.duration : (plan.sim ? 10.0 : 0.0);
   CheckRange(plan.duration, 0.0, 1e7, "--duration");
@@ -196,115 +204,182 @@ nlohmann::ordered_json SummaryJson(const LiveSummary& s, const std::string& stop
       {"loop_ms_p95", p95}};
 }
 
-int RunLive(const LiveCommandOptions& opt) {
-  const LivePlan plan = CheckFlags(opt);
-  LiveInputs inputs;
-  inputs.camera = ReadCameraXml(opt.camera_path);
-  if (inputs.camera.width <= 0) {
-    throw InputError(opt.camera_path + ": the camera file gives no image size");
+// The files a live run reads, loaded and checked; inputs() points into this object.
+class LiveFiles {
+ public:
+  LiveFiles(const LiveCommandOptions& opt, const LivePlan& plan)
+      : camera_(ReadLiveCamera(opt.camera_path)), model_(LoadModel(opt.model_path)) {
+    inputs_.camera = camera_;
+    inputs_.model = &model_;
+    if (!opt.prior_file.empty()) inputs_.priors = ReadPriors(opt.prior_file);
+    if (!opt.mount.empty()) inputs_.mount = ReadMountFile(opt.mount);
+    inputs_.mount_path = opt.mount;
+    if (!opt.prior_file.empty() && inputs_.priors.empty()) {
+      throw InputError(opt.prior_file + ": no prior rows");
+    }
+    inputs_.tracker.matcher.noise = DetectedLineNoise();
+    inputs_.tracker.sequence.integrity = opt.integrity.Options();
+    if (!opt.settings.empty()) inputs_.tracker.settings = ReadTrackerSettings(opt.settings);
+    if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
+        plan.sim_camera.render_options.scene.clutter > 0) {
+      NavigableAreaOptions area_options;
+      area_options.sidecar_path = opt.nav_path;
+      area_ = NavigableArea::FromModel(model_, area_options);
+      inputs_.area = &*area_;
+    }
   }
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
-  for (const std::string& w : model.warnings())
-    spdlog::warn("{}", w);
-  inputs.model = &model;
-  if (!opt.prior_file.empty()) inputs.priors = ReadPriors(opt.prior_file);
-  if (!opt.prior_file.empty() && inputs.priors.empty()) {
-    throw InputError(opt.prior_file + ": no prior rows");
-  }
-  inputs.tracker.matcher.noise = DetectedLineNoise();
-  if (!opt.settings.empty()) inputs.tracker.settings = ReadTrackerSettings(opt.settings);
-  std::optional<NavigableArea> area;
-  if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
-      plan.sim_camera.render_options.scene.clutter > 0) {
-    NavigableAreaOptions area_options;
-    area_options.sidecar_path = opt.nav_path;
-    area = NavigableArea::FromModel(model, area_options);
-    inputs.area = &*area;
-  }
-  LiveSession session(plan, inputs);
-  LiveLoop& loop = session.loop();
-  const CameraIntrinsics& camera = inputs.camera;
+  LiveFiles(const LiveFiles&) = delete;
+  LiveFiles& operator=(const LiveFiles&) = delete;
 
-  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr);
-  spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
-               session.DescribeHead(), session.DescribeEstimator(), plan.duration);
-  const std::vector<ProjectedEdge> no_edges;
-  LiveWindow window;
-  bool window_tried = false;
-  const OcclusionTester occlusion(model);
+  const LiveInputs& inputs() const { return inputs_; }
+  const WireframeModel& model() const { return model_; }
+
+ private:
+  static CameraIntrinsics ReadLiveCamera(const std::string& path) {
+    CameraIntrinsics camera = LoadCamera(path);
+    if (camera.width <= 0) throw InputError(path + ": the camera file gives no image size");
+    return camera;
+  }
+
+  CameraIntrinsics camera_;
+  WireframeModel model_;
+  std::optional<NavigableArea> area_;
+  LiveInputs inputs_;
+};
+
+// The overlays of a live run: a snapshot every --snapshot-every frames, and every frame in the
+// window when --display finds one.
+class LiveViews {
+ public:
+  LiveViews(const LiveCommandOptions& opt, const WireframeModel& model,
+            const CameraIntrinsics& camera)
+      : snapshot_every_(opt.snapshot_every),
+        display_(opt.display),
+        model_(model),
+        camera_(camera),
+        occlusion_(model) {}
+
+  // Draws the overlay of `it` when a snapshot or the window wants it.
+  void Show(const LiveIteration& it, LiveLoop& loop, LiveOutput* output) {
+    const bool snapshot = snapshot_every_ > 0 && it.frame >= 0 && it.frame % snapshot_every_ == 0;
+    const bool show = it.frame >= 0 && (window_.is_open() || (display_ && !window_tried_));
+    if (!snapshot && !show) return;
+    const vpImage<vpRGBa> overlay =
+        DrawLiveOverlay(loop.last_frame().image, it,
+                        it.estimate.has_pose()
+                            ? ProjectVisibleEdges(model_, occlusion_, *it.estimate.cam_from_world,
+                                                  camera_.Undistorted())
+                            : std::vector<ProjectedEdge>(),
+                        camera_, loop.desired_px());
+    if (snapshot) output->Snapshot(it.frame, overlay);
+    if (show && !window_tried_) {
+      window_tried_ = true;
+      std::string why;
+      if (!window_.Open(overlay, &why)) spdlog::warn("--display: no window ({}): headless", why);
+    }
+    if (window_.is_open()) window_.Show(overlay);
+  }
+
+ private:
+  int snapshot_every_;
+  bool display_;
+  const WireframeModel& model_;
+  const CameraIntrinsics& camera_;
+  const OcclusionTester occlusion_;
+  LiveWindow window_;
+  bool window_tried_ = false;
+};
+
+// How a live run's loop ended.
+struct LiveRunEnd {
   LiveSummary summary;
   std::string stop_reason = "duration";
-  HeadResult stopped;
-  std::exception_ptr failure;
+  HeadResult stopped;          // the head's stop at the end
+  std::exception_ptr failure;  // an error in the middle of the run, rethrown after the files
+  IntegrityTally integrity;    // statuses and sigmas, with a simulator's truth the failures
+};
+
+// Steps the loop until the duration, the end of the source, a signal or an error; then stops
+// the head first.
+LiveRunEnd RunLoop(const LivePlan& plan, LiveSession* session, LiveViews* views,
+                   LiveOutput* output) {
+  LiveLoop& loop = session->loop();
+  LiveRunEnd end;
   // Simulated time: the duration is a number of frames; real devices: wall-clock seconds. 0: until
   // stopped (or the end of a recorded source).
   const std::int64_t max_frames = plan.sim ? std::llround(plan.duration * plan.sim_camera.fps) : 0;
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                             std::chrono::duration<double>(plan.duration));
-  {
-    StopSignals signals;
-    try {
-      while (true) {
-        if (StopSignals::Received() != 0) {
-          stop_reason = "signal " + StopSignals::ReceivedName();
-          break;
-        }
-        const LiveIteration it = loop.Step();
-        if (it.grab == FrameStatus::kEndOfStream) {
-          stop_reason = "end of stream";
-          break;
-        }
-        summary.Add(it);
-        if (summary.frames == 1 && it.grab == FrameStatus::kOk) {
-          spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
-        }
-        output.Add(it, session.truth());
-        const bool snapshot =
-            opt.snapshot_every > 0 && it.frame >= 0 && it.frame % opt.snapshot_every == 0;
-        const bool show = it.frame >= 0 && (window.is_open() || (opt.display && !window_tried));
-        if (snapshot || show) {
-          const vpImage<vpRGBa> overlay = DrawLiveOverlay(
-              loop.last_frame().image, it,
-              it.estimate.has_pose()
-                  ? ProjectVisibleEdges(model, occlusion, *it.estimate.cam_from_world,
-                                        camera.Undistorted())
-                  : no_edges,
-              camera, loop.desired_px());
-          if (snapshot) output.Snapshot(it.frame, overlay);
-          if (show && !window_tried) {
-            window_tried = true;
-            std::string why;
-            if (!window.Open(overlay, &why))
-              spdlog::warn("--display: no window ({}): headless", why);
-          }
-          if (window.is_open()) window.Show(overlay);
-        }
-        if (max_frames > 0 && summary.frames >= max_frames) break;
-        if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
+  StopSignals signals;
+  try {
+    while (true) {
+      if (StopSignals::Received() != 0) {
+        end.stop_reason = "signal " + StopSignals::ReceivedName();
+        break;
       }
-    } catch (const std::exception& e) {
-      // A failure in the middle of a run (a frame of the wrong size, a file that cannot be
-      // written): stop the head, complete the files, then report it.
-      failure = std::current_exception();
-      stop_reason = std::string("error: ") + e.what();
+      const LiveIteration it = loop.Step();
+      if (it.grab == FrameStatus::kEndOfStream) {
+        end.stop_reason = "end of stream";
+        break;
+      }
+      end.summary.Add(it);
+      if (end.summary.frames == 1 && it.grab == FrameStatus::kOk) {
+        spdlog::info("live: first frame: t {:.3f} s, {}", it.t, ToString(it.estimate.status));
+      }
+      output->Add(it, session->truth());
+      std::optional<IntegrityCheck> check;
+      if (it.estimate.has_pose() && session->truth() != nullptr) {
+        check = CheckAgainstTruth(it.estimate.uncertainty, *it.estimate.cam_from_world,
+                                  *session->truth(), /*robot=*/true);
+      }
+      end.integrity.Add(it.estimate.uncertainty, check);
+      views->Show(it, loop, output);
+      if (max_frames > 0 && end.summary.frames >= max_frames) break;
+      if (!plan.sim && plan.duration > 0.0 && std::chrono::steady_clock::now() >= deadline) break;
     }
-    stopped = loop.SafeStop();  // the head first, then the files
-    if (!stopped.ok()) spdlog::error("head: could not stop: {}", stopped.message);
+  } catch (const std::exception& e) {
+    // A failure in the middle of a run (a frame of the wrong size, a file that cannot be
+    // written): stop the head, complete the files, then report it.
+    end.failure = std::current_exception();
+    end.stop_reason = std::string("error: ") + e.what();
   }
-  nlohmann::ordered_json json = SummaryJson(summary, stop_reason);
-  json["head_stopped_at_end"] = stopped.ok();
+  end.stopped = loop.SafeStop();  // the head first, then the files
+  if (!end.stopped.ok()) spdlog::error("head: could not stop: {}", end.stopped.message);
+  return end;
+}
+
+// summary.json of the run: the loop's figures, how it stopped, what it ran on.
+nlohmann::ordered_json RunSummaryJson(const LiveRunEnd& end, LiveSession& session,
+                                      const IntegrityOptions& integrity) {
+  nlohmann::ordered_json json = SummaryJson(end.summary, end.stop_reason);
+  json["head_stopped_at_end"] = end.stopped.ok();
   json["source"] = session.DescribeSource();
   json["head"] = session.DescribeHead();
   json["estimator"] = session.DescribeEstimator();
+  json["mount"] = session.DescribeMount();
+  LiveLoop& loop = session.loop();
   if (loop.target()) json["target"] = {loop.target()->x(), loop.target()->y(), loop.target()->z()};
   json["target_pixel"] = {loop.desired_px().x(), loop.desired_px().y()};
-  output.Finish(json);
-  if (failure) std::rethrow_exception(failure);
-  std::cout << "live: " << summary.frames << " frames, " << summary.with_pose << " with a pose, "
-            << "final error " << summary.final_error_px << " px, stopped by " << stop_reason
-            << "; wrote " << opt.out << std::endl;
-  return summary.with_pose > 0 ? kExitOk : kExitJobFailed;
+  json["integrity"] = end.integrity.Summary(integrity);
+  return json;
+}
+
+int RunLive(const LiveCommandOptions& opt) {
+  const LivePlan plan = CheckFlags(opt);
+  const LiveFiles files(opt, plan);
+  LiveSession session(plan, files.inputs());
+  LiveOutput output(opt.out, /*with_truth=*/session.truth() != nullptr, opt.integrity.all_poses);
+  spdlog::info("live: started: source {}, head {}, estimator {}, {} s", session.DescribeSource(),
+               session.DescribeHead(), session.DescribeEstimator(), plan.duration);
+  LiveViews views(opt, files.model(), files.inputs().camera);
+  const LiveRunEnd end = RunLoop(plan, &session, &views, &output);
+  output.Finish(RunSummaryJson(end, session, files.inputs().tracker.sequence.integrity));
+  if (end.failure) std::rethrow_exception(end.failure);
+  std::cout << "live: " << end.summary.frames << " frames, " << end.summary.with_pose
+            << " with a pose, final error " << end.summary.final_error_px << " px, stopped by "
+            << end.stop_reason << "; wrote " << opt.out << std::endl;
+  return end.summary.with_pose > 0 ? kExitOk : kExitJobFailed;
 }
 
 }  // namespace
@@ -321,10 +396,15 @@ void AddLive(CLI::App& cli, CommandAction* action) {
       ->required();
   cmd->add_option("--head", opt->head, "ptu:/dev/ttyUSB0 | sim")->required();
   cmd->add_option("--model", opt->model_path, "ViSP .cao model file")->required();
-  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML file (with its image size)")
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (with its image size)")
       ->required();
-  cmd->add_option("--height", opt->height, "Camera height above the floor, head level (metres)")
-      ->required();
+  cmd->add_option("--height", opt->height,
+                  "Camera height above the floor, head level (metres; with a --mount that has a "
+                  "floor calibration it may be left out)");
+  cmd->add_option("--mount", opt->mount,
+                  "mount.json of linetrack calibrate-mount: the calibrated camera mount (and its "
+                  "floor height) instead of --head-model's nominal geometry (and --height)");
   cmd->add_option("--out", opt->out, "Output folder")->required();
   cmd->add_option(
       "--prior", opt->prior,
@@ -356,10 +436,16 @@ void AddLive(CLI::App& cli, CommandAction* action) {
                   "Camera pose: auto (= tracker) | tracker | truth (the simulator's, sim only)")
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
+  AddIntegrityFlags(cmd, &opt->integrity);
+  AddAllPosesFlag(cmd, &opt->integrity);
   cmd->add_option("--camera-fps", opt->camera_fps,
                   "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {
     opt->duration_given = cmd->get_option("--duration")->count() > 0;
+    RefuseUnless(*cmd, opt->estimator != "truth", {"--settings"},
+                 "the tracker's settings; --estimator truth uses no tracker");
+    RefuseUnless(*cmd, opt->source.rfind("aravis", 0) == 0, {"--camera-fps"},
+                 "sets the frame rate of an Aravis camera (--source aravis[:ID])");
     *action = [opt] { return RunLive(*opt); };
   });
 }

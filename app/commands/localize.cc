@@ -7,22 +7,32 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "app/commands.h"
 #include "app/image_overlay.h"
+#include "app/integrity_output.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
+#include "tracking/integrity/image_pose_check.h"
+#include "tracking/tracker/image_undistorter.h"
+#include "tracking/tracker/relocalizer.h"
 
 namespace linetrack::app {
 namespace {
 
 struct LocalizeOptions {
   std::string model_path, camera_path, camera_name, lines_path, prior_text, batch_path;
-  double delta_t = 0.0, delta_phi_deg = 0.0, height = 0.0, tilt_deg = 0.0;
+  // The prior's bounds default to those of `replay`'s first prior (the paper's QI3).
+  double delta_t = SearchBounds().delta_t;
+  double delta_phi_deg = RadToDeg(SearchBounds().delta_phi);
+  double height = 0.0, tilt_deg = 0.0;
+  int storey = -1;
+  double floor_z = std::numeric_limits<double>::quiet_NaN();
   std::string method = "tree";
   bool json = false;
   bool global = false;  // no prior: heading candidates searched over the whole navigable area
@@ -33,7 +43,49 @@ struct LocalizeOptions {
   // the relative focal-length error of the camera file (default the paper's 2 %).
   std::string line_noise;
   double focal_error = LineNoise().focal_relative;
+  // With --image: the answer's covariance and protection levels (its alert limit and the
+  // calibration and model uncertainty).
+  IntegrityFlags integrity;
 };
+
+// The integrity of the matcher's answer on its image: the moving edges and their sub-pixel points
+// at the answer (known height and tilt).
+PoseUncertainty CheckAnswer(const LocalizeOptions& opt, const ImageLines& image,
+                            const LocalizationProblem& problem, const LocalizationResult& result,
+                            const IntegrityOptions& options) {
+  CameraIntrinsics camera = image.camera;
+  if (camera.width <= 0) {  // a camera file without the image size: the image's
+    camera.width = static_cast<int>(image.image.getWidth());
+    camera.height = static_cast<int>(image.image.getHeight());
+  }
+  EdgeTracker tracker(opt.model_path, camera, TrackerSettings());
+  ImageUndistorter undistorter(camera);
+  return UncertaintyOf(CheckPoseOnImage(&tracker, undistorter.Apply(image.image),
+                                        result.cam_from_world,
+                                        KnownHeightTilt{problem.height, problem.tilt}, options));
+}
+
+// An answer whose protection levels exceed the alert limit is no answer: "ambiguous" when the
+// matcher compared rivals (listed), else "none"; the candidate stays in the JSON with its
+// covariance.
+void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
+                    nlohmann::ordered_json* json) {
+  (*json)["found"] = false;
+  (*json)["answer"] = result.finalists.size() > 1 ? "ambiguous" : "none";
+  (*json)["reason"] = "the answer is not within the alert limit: " + u.reason;
+  (*json)["candidate"] = (*json)["pose"];
+  (*json)["pose"] = nullptr;
+  (*json)["cMo"] = nullptr;
+  nlohmann::ordered_json rivals = nlohmann::ordered_json::array();
+  for (const Finalist& f : result.finalists) {
+    rivals.push_back({{"x", f.pose.x},
+                      {"y", f.pose.y},
+                      {"heading_deg", RadToDeg(WrapAngle(f.pose.heading))},
+                      {"matched_edges", f.matched_edges},
+                      {"mean_distance_px", f.mean_distance_px}});
+  }
+  (*json)["rivals"] = rivals;
+}
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
@@ -72,28 +124,29 @@ int RunBatch(const LocalizeOptions& opt) {
     ++number;
     if (row.find_first_not_of(" \t\r") == std::string::npos) continue;
     ++cases;
-    std::string id = "line-" + std::to_string(number);
+    nlohmann::json id = "line-" + std::to_string(number);  // a case without an id: its line
     try {
       const nlohmann::json json = nlohmann::json::parse(row);
-      if (json.is_object() && json.contains("id")) {
-        id = json["id"].is_string() ? json["id"].get<std::string>() : json["id"].dump();
-      }
+      if (json.is_object() && json.contains("id")) id = json["id"];
       BatchCase c = ParseBatchCase(json, base_dir);
       if (c.global) {
         const GlobalLocalizer& global = cache.GetGlobal(c.model_path, c.camera_path, c.camera_name);
+        const WireframeModel& model = *cache.Model(c.model_path).model;
+        const double z = CameraZ(model, c.problem.height, c.storey, c.floor_z);
         const auto start = std::chrono::steady_clock::now();
-        const GlobalResult result =
-            global.Localize({c.problem.lines, c.problem.height, c.problem.tilt});
+        const GlobalResult result = global.Localize({c.problem.lines, z, c.problem.tilt});
         found += result.found ? 1 : 0;
-        std::cout << GlobalResultToJson(id, result, Milliseconds(start)).dump() << "\n";
+        std::cout << GlobalResultToJson(id, result, Milliseconds(start), &model).dump() << "\n";
         continue;
       }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
+      c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
       const auto start = std::chrono::steady_clock::now();
       const LocalizationResult result = localizer.Localize(c.problem);
       const double ms = Milliseconds(start);
       found += result.found ? 1 : 0;
-      std::cout << ResultToJson(id, result, ms).dump() << "\n";
+      std::cout << ResultToJson(id, result, ms, cache.Model(c.model_path).model.get()).dump()
+                << "\n";
     } catch (const nlohmann::json::parse_error&) {
       std::cout << nlohmann::ordered_json{{"id", id},
                                           {"found", false},
@@ -130,7 +183,29 @@ void PrintGlobal(const GlobalResult& global, double ms) {
   }
 }
 
+// The result as text: the pose and each match with its edge's name, or why there is none.
+void PrintResult(const LocalizationResult& result, const WireframeModel& model, double ms) {
+  if (result.found) {
+    std::cout << std::fixed << std::setprecision(3) << "pose      x " << result.pose.x << " m, y "
+              << result.pose.y << " m, heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading)) << " deg\n"
+              << "matches   " << result.matches.size() << " (model edge <- image line)\n";
+    for (const auto& [e, l] : result.matches) {
+      const std::string& name = model.edges().at(static_cast<size_t>(e)).name;
+      std::cout << "          edge " << e << (name.empty() ? "" : " " + name) << " <- line " << l
+                << "\n";
+    }
+    std::cout << "score     " << result.score_px << " px, support " << result.support
+              << "\nsearch    " << result.candidate_edges << " candidate edges, "
+              << result.hypotheses << " hypotheses, " << ms << " ms\n";
+  } else {
+    std::cout << "no pose: " << result.reason << " (" << result.hypotheses << " hypotheses, "
+              << std::fixed << std::setprecision(2) << ms << " ms)\n";
+  }
+}
+
 int RunSingle(const LocalizeOptions& opt) {
+  CheckHeight(opt.height, "--height");
   LocalizationProblem problem;
   if (!opt.global) {
     problem.prior = ParsePrior(opt.prior_text, "--prior");
@@ -148,10 +223,17 @@ int RunSingle(const LocalizeOptions& opt) {
   } else {
     problem.lines = ReadLinesCsv(opt.lines_path);
   }
+  try {
+    if (!problem.lines.empty() && !opt.global) CheckProblem(problem);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  const IntegrityOptions integrity_options = opt.integrity.Options();
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
   const GlobalLocalizer* global =
       opt.global ? &cache.GetGlobal(opt.model_path, opt.camera_path, opt.camera_name) : nullptr;
+  problem.height = CameraZ(localizer.model(), opt.height, opt.storey, opt.floor_z);
   const auto start = std::chrono::steady_clock::now();
   LocalizationResult result;
   std::optional<GlobalResult> global_result;
@@ -163,13 +245,18 @@ int RunSingle(const LocalizeOptions& opt) {
       result = global_result->found ? global_result->best : LocalizationResult();
       result.reason = global_result->reason;
     } else {
-      CheckProblem(problem);
       result = localizer.Localize(problem);
     }
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
   const double ms = Milliseconds(start);
+  std::optional<PoseUncertainty> integrity;
+  if (image && result.found) {
+    integrity = CheckAnswer(opt, *image, problem, result, integrity_options);
+  }
+  const bool answered =
+      result.found && (!integrity || integrity->status == IntegrityStatus::kTracking);
   if (image && !opt.overlay_path.empty()) {
     WriteFileAtomically(
         opt.overlay_path,
@@ -182,28 +269,35 @@ int RunSingle(const LocalizeOptions& opt) {
   if (global_result && !opt.json) PrintGlobal(*global_result, ms);
   if (opt.json) {
     const std::string id = std::filesystem::path(source).stem().string();
-    nlohmann::ordered_json json =
-        global_result ? GlobalResultToJson(id, *global_result, ms) : ResultToJson(id, result, ms);
+    const WireframeModel* model = cache.Model(opt.model_path).model.get();
+    nlohmann::ordered_json json = global_result ? GlobalResultToJson(id, *global_result, ms, model)
+                                                : ResultToJson(id, result, ms, model);
     if (image) {
       json["lines"] = image->segments.size();
       json["lines_ms"] = image->ms;
     }
+    if (integrity) {
+      json["integrity"] = UncertaintyJson(*integrity);
+      if (!answered) WithholdAnswer(result, *integrity, &json);
+    }
     std::cout << json.dump(2) << std::endl;
-  } else if (result.found) {
-    std::cout << std::fixed << std::setprecision(3) << "pose      x " << result.pose.x << " m, y "
-              << result.pose.y << " m, heading " << std::setprecision(2)
-              << RadToDeg(WrapAngle(result.pose.heading)) << " deg\n"
-              << "matches   " << result.matches.size() << " (edge:line";
-    for (const auto& [e, l] : result.matches)
-      std::cout << " " << e << ":" << l;
-    std::cout << ")\nscore     " << result.score_px << " px, support " << result.support
-              << "\nsearch    " << result.candidate_edges << " candidate edges, "
-              << result.hypotheses << " hypotheses, " << ms << " ms\n";
-  } else if (!global_result) {
-    std::cout << "no pose: " << result.reason << " (" << result.hypotheses << " hypotheses, "
-              << std::fixed << std::setprecision(2) << ms << " ms)\n";
+  } else if (result.found && !answered) {
+    std::cout << "no answer: the pose found (x " << std::fixed << std::setprecision(3)
+              << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading))
+              << " deg) is not within the alert limit: " << integrity->reason << " ("
+              << result.finalists.size() << " rivals)\n";
+  } else if (result.found || !global_result) {  // a global failure: PrintGlobal said why
+    PrintResult(result, *cache.Model(opt.model_path).model, ms);
+    if (integrity && result.found) {
+      std::cout << std::fixed << std::setprecision(3) << "integrity " << ToString(integrity->status)
+                << ": sigma x " << integrity->sigma_x_m << " m, y " << integrity->sigma_y_m
+                << " m, heading " << RadToDeg(integrity->sigma_heading_rad) << " deg; protection "
+                << integrity->protection_position_m << " m, "
+                << RadToDeg(integrity->protection_rotation_rad) << " deg\n";
+    }
   }
-  return result.found ? kExitOk : kExitJobFailed;
+  return answered ? kExitOk : kExitJobFailed;
 }
 
 }  // namespace
@@ -215,7 +309,8 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       "Camera pose from image line segments against a .cao model, from a rough prior "
       "(interpretation-tree matcher after Ait Aider et al. 2005)");
   cmd->add_option("--model", opt->model_path, "ViSP .cao model");
-  cmd->add_option("--camera", opt->camera_path, "ViSP camera XML (undistorted pixels)");
+  cmd->add_option("--camera", opt->camera_path,
+                  "Camera file: ViSP XML, OpenCV or ROS YAML (undistorted pixels)");
   cmd->add_option("--camera-name", opt->camera_name, "Camera name in the XML (default: first)");
   cmd->add_option("--lines", opt->lines_path, "CSV of segments u1,v1,u2,v2 in pixels");
   cmd->add_option("--image", opt->image_path,
@@ -234,38 +329,51 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
   cmd->add_flag("--global", opt->global,
                 "No prior: anywhere in the navigable area, any heading, instead of --prior, "
                 "--delta-t and --delta-phi (docs/global.md)");
-  cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)");
-  cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
+  cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)")
+      ->capture_default_str();
+  cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)")
+      ->capture_default_str();
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
+  cmd->add_option("--storey", opt->storey,
+                  "The storey the camera stands on (0 the lowest, default); --height is above "
+                  "its floor")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--floor-z", opt->floor_z,
+                  "World z of the floor the camera stands on (metres), instead of --storey");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
   cmd->add_flag("--json", opt->json, "Print the result as JSON (the batch format)");
+  AddIntegrityFlags(cmd, &opt->integrity);
   cmd->add_option("--batch", opt->batch_path,
                   "JSON-lines file of cases; prints one JSON result per line, in order");
   cmd->add_option("--method", opt->method, "tree (default) or baseline (hypothesise-and-test)")
       ->check(CLI::IsMember({"tree", "baseline"}));
   cmd->callback([opt, action, cmd] {
-    if (!opt->batch_path.empty()) {
+    const bool batch = !opt->batch_path.empty();
+    RefuseUnless(
+        *cmd, !batch,
+        {"--model", "--camera", "--camera-name", "--lines", "--image", "--overlay", "--prior",
+         "--delta-t", "--delta-phi", "--height", "--storey", "--floor-z", "--tilt", "--json"},
+        "not with --batch (each case of the batch gives its own)");
+    RefuseUnless(*cmd, cmd->count("--image") > 0,
+                 {"--overlay", "--detector", "--min-length", "--roi", "--no-merge", "--undistort"},
+                 "applies to the lines extracted from an --image");
+    if (batch) {
       *action = [opt] { return RunBatch(*opt); };
       return;
     }
     for (const char* flag : {"--prior", "--delta-t", "--delta-phi"}) {
       if (opt->global && cmd->count(flag) > 0) {
-        throw CLI::ValidationError(std::string(flag), "is not given with --global");
+        throw CLI::ValidationError(flag, "is not given with --global");
       }
-      if (!opt->global && cmd->count(flag) == 0) {
-        throw CLI::RequiredError(std::string(flag) + " is required without --batch or --global");
-      }
+    }
+    if (!opt->global && cmd->count("--prior") == 0) {
+      throw CLI::ValidationError("--prior", "required without --batch or --global");
     }
     for (const char* flag : {"--model", "--camera", "--height", "--tilt"}) {
-      if (cmd->count(flag) == 0) {
-        throw CLI::RequiredError(std::string(flag) + " is required without --batch");
-      }
+      if (cmd->count(flag) == 0) throw CLI::ValidationError(flag, "required without --batch");
     }
     if (cmd->count("--lines") + cmd->count("--image") != 1) {
-      throw CLI::RequiredError("give one of --lines and --image (without --batch)");
-    }
-    if (cmd->count("--overlay") > 0 && cmd->count("--image") == 0) {
-      throw CLI::ValidationError("--overlay", "draws over an --image");
+      throw CLI::ValidationError("--lines, --image", "give one of them (without --batch)");
     }
     *action = [opt] { return RunSingle(*opt); };
   });

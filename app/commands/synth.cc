@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loading.h"
 #include "models/errors.h"
 #include "models/synth/synthetic_scenes.h"
 
@@ -37,6 +38,7 @@ struct SynthCommandOptions {
   double offset_sigma_px = SyntheticSceneOptions().offset_sigma_px;
   int parallel_clutter = 0;  // near-parallel unmodelled lines per scene (0: none)
   bool exact = false;
+  int storey = 0;  // the storey the poses are drawn on
 };
 
 // "LO,HI" -> two finite numbers with LO <= HI; throws InputError naming `flag`.
@@ -77,8 +79,8 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   o.count = opt.count;
   const auto [h_lo, h_hi] = ParseRange(opt.height_range, "--height-range");
   const auto [t_lo, t_hi] = ParseRange(opt.tilt_range, "--tilt-range");
-  CheckRange(h_lo, 0.0, 100.0, "--height-range");
-  CheckRange(h_hi, 0.0, 100.0, "--height-range");
+  CheckHeight(h_lo, "--height-range");
+  CheckHeight(h_hi, "--height-range");
   CheckRange(t_lo, -89.0, 89.0, "--tilt-range");
   CheckRange(t_hi, -89.0, 89.0, "--tilt-range");
   o.height_min = h_lo;
@@ -114,7 +116,7 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   if (opt.exact) o.shorten_max = o.split_probability = 0.0;
   o.parallel_clutter = opt.parallel_clutter;
   if (!opt.camera_path.empty()) {
-    o.camera = ReadCameraXml(opt.camera_path);
+    o.camera = LoadCamera(opt.camera_path);
     if (o.camera.width <= 0 || o.camera.height <= 0) {
       throw InputError(Located(opt.camera_path, 0, "the camera file gives no image size"));
     }
@@ -124,23 +126,27 @@ SyntheticSceneOptions SceneOptions(const SynthCommandOptions& opt, std::string* 
   return o;
 }
 
+// Heights in the files are above the storey's floor; "storey" is written for a storey above 0.
 nlohmann::ordered_json CaseJson(const SyntheticScene& s, const std::string& id,
-                                const std::string& model) {
+                                const std::string& model, const SyntheticSceneOptions& o) {
   nlohmann::ordered_json lines = nlohmann::ordered_json::array();
   for (const Segment2& l : s.lines)
     lines.push_back({l.a.x(), l.a.y(), l.b.x(), l.b.y()});
-  return {{"id", id},
-          {"model", model},
-          {"camera", "camera.xml"},
-          {"lines", lines},
-          {"prior", {s.prior.x, s.prior.y, RadToDeg(s.prior.heading)}},
-          {"delta_t", s.delta_t},
-          {"delta_phi", RadToDeg(s.delta_phi)},
-          {"height", s.height},
-          {"tilt", RadToDeg(s.tilt)}};
+  nlohmann::ordered_json json = {{"id", id},
+                                 {"model", model},
+                                 {"camera", "camera.xml"},
+                                 {"lines", lines},
+                                 {"prior", {s.prior.x, s.prior.y, RadToDeg(s.prior.heading)}},
+                                 {"delta_t", s.delta_t},
+                                 {"delta_phi", RadToDeg(s.delta_phi)},
+                                 {"height", s.height - o.floor_z},
+                                 {"tilt", RadToDeg(s.tilt)}};
+  if (o.storey > 0) json["storey"] = o.storey;
+  return json;
 }
 
-nlohmann::ordered_json TruthJson(const SyntheticScene& s, const std::string& id) {
+nlohmann::ordered_json TruthJson(const SyntheticScene& s, const std::string& id,
+                                 const SyntheticSceneOptions& o) {
   nlohmann::ordered_json cmo = nlohmann::ordered_json::array();
   const Eigen::Matrix4d m = CamFromWorld(s.truth).matrix();
   for (int r = 0; r < 4; ++r)
@@ -153,7 +159,7 @@ nlohmann::ordered_json TruthJson(const SyntheticScene& s, const std::string& id)
            {{"x", s.truth.x},
             {"y", s.truth.y},
             {"heading_deg", RadToDeg(s.truth.heading)},
-            {"height", s.truth.height},
+            {"height", s.truth.height - o.floor_z},
             {"tilt_deg", RadToDeg(s.truth.tilt)}}},
           {"cMo", cmo},
           {"matches", matches},
@@ -179,10 +185,16 @@ std::string ModelPathFrom(const std::string& model_path, const std::string& out_
 int RunSynth(const SynthCommandOptions& opt) {
   if (opt.count <= 0) throw InputError("--count: must be > 0");
   std::string id_stem;
-  const SyntheticSceneOptions options = SceneOptions(opt, &id_stem);
+  SyntheticSceneOptions options = SceneOptions(opt, &id_stem);
   const std::string camera_xml = opt.camera_path.empty() ? "" : ReadWholeFile(opt.camera_path);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
+  if (opt.storey >= static_cast<int>(model.storeys().size())) {
+    throw InputError("--storey: " + opt.model_path + " has " +
+                     std::to_string(model.storeys().size()) + " storeys (0 is the lowest)");
+  }
+  options.storey = opt.storey;
+  options.floor_z = model.storeys()[opt.storey].floor_z;
   const OcclusionTester occlusion(model);
 
   const auto start = std::chrono::steady_clock::now();
@@ -195,8 +207,8 @@ int RunSynth(const SynthCommandOptions& opt) {
     char index[16];
     std::snprintf(index, sizeof(index), "-%05d", i);
     const std::string id = id_stem + index;
-    cases << CaseJson(scene, id, model_ref).dump() << "\n";
-    truth << TruthJson(scene, id).dump() << "\n";
+    cases << CaseJson(scene, id, model_ref, options).dump() << "\n";
+    truth << TruthJson(scene, id, options).dump() << "\n";
     model_lines += static_cast<int>(scene.matches.size());
     clutter_lines += static_cast<int>(scene.clutter.size());
     attempts += scene.attempts;
@@ -240,12 +252,18 @@ void AddSynth(CLI::App& cli, CommandAction* action) {
       ->check(CLI::IsMember({1, 2, 3}));
   cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres), with --delta-phi");
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)");
-  cmd->add_option("--height-range", opt->height_range, "Camera height range LO,HI (metres)")
+  cmd->add_option("--storey", opt->storey,
+                  "Draw the poses on this storey (0 the lowest); heights are above its floor")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--height-range", opt->height_range,
+                  "Camera height range LO,HI above the floor (metres)")
       ->capture_default_str();
   cmd->add_option("--tilt-range", opt->tilt_range, "Camera tilt range LO,HI (degrees)")
       ->capture_default_str();
-  cmd->add_option("--camera", opt->camera_path,
-                  "ViSP camera XML (default: 640x480, px = py = 1000, centre 320,240)");
+  cmd->add_option(
+      "--camera", opt->camera_path,
+      "Camera file: ViSP XML, OpenCV or ROS YAML (default: 640x480, px = py = 1000, centre "
+      "320,240)");
   cmd->add_option("--calibration-sigma", opt->calibration_sigma,
                   "Std of the multiplicative focal-length error eps_m")
       ->capture_default_str();
@@ -260,6 +278,8 @@ void AddSynth(CLI::App& cli, CommandAction* action) {
   cmd->callback([opt, action, cmd] {
     opt->has_delta_t = cmd->count("--delta-t") > 0;
     opt->has_delta_phi = cmd->count("--delta-phi") > 0;
+    RefuseUnless(*cmd, !opt->exact, {"--calibration-sigma", "--angle-sigma", "--offset-sigma"},
+                 "not with --exact (no calibration error or line noise)");
     *action = [opt] { return RunSynth(*opt); };
   });
 }

@@ -17,6 +17,7 @@
 #include "app/line_flags.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
+#include "app/model_loading.h"
 #include "app/rendered_key_view.h"
 #include "matching/views/view_positioning.h"
 #include "matching/views/view_store.h"
@@ -55,7 +56,7 @@ ViewGrid ParseGrid(const ViewsBuildOptions& opt) {
 
 int RunViewsBuild(const ViewsBuildOptions& opt) {
   const ViewGrid grid = ParseGrid(opt);
-  const WireframeModel model = WireframeModel::Load(opt.model_path);
+  const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const CameraIntrinsics camera = ReadCameraXml(opt.camera_path, opt.camera_name);
   if (camera.width <= 0)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "matching/pose_decision.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 

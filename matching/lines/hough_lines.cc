@@ -209,23 +209,24 @@ void HoughLineDetector::ExtractChains(double theta_deg, double rho,
   }
 }
 
-std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
-  CV_Assert(grey.type() == CV_8UC1 && !grey.empty());
-  if (grey.cols != width_ || grey.rows != height_ || n_theta_ == 0) {
-    width_ = grey.cols;
-    height_ = grey.rows;
-    n_theta_ = static_cast<int>(std::lround(180.0 / options_.theta_step_deg));
-    rho_max_ = std::ceil(0.5 * std::hypot(width_, height_)) + 1.0;
-    n_rho_ = 2 * static_cast<int>(rho_max_) + 1;
-    cos_.resize(n_theta_);
-    sin_.resize(n_theta_);
-    for (int k = 0; k < n_theta_; ++k) {
-      cos_[k] = std::cos(DegToRad(k * options_.theta_step_deg));
-      sin_[k] = std::sin(DegToRad(k * options_.theta_step_deg));
-    }
-    accumulator_.assign(static_cast<size_t>(n_theta_) * n_rho_, 0);
-    pixel_at_.assign(static_cast<size_t>(width_) * height_, -1);
+void HoughLineDetector::Resize(const cv::Mat& grey) {
+  if (grey.cols == width_ && grey.rows == height_ && n_theta_ != 0) return;
+  width_ = grey.cols;
+  height_ = grey.rows;
+  n_theta_ = static_cast<int>(std::lround(180.0 / options_.theta_step_deg));
+  rho_max_ = std::ceil(0.5 * std::hypot(width_, height_)) + 1.0;
+  n_rho_ = 2 * static_cast<int>(rho_max_) + 1;
+  cos_.resize(n_theta_);
+  sin_.resize(n_theta_);
+  for (int k = 0; k < n_theta_; ++k) {
+    cos_[k] = std::cos(DegToRad(k * options_.theta_step_deg));
+    sin_[k] = std::sin(DegToRad(k * options_.theta_step_deg));
   }
+  accumulator_.assign(static_cast<size_t>(n_theta_) * n_rho_, 0);
+  pixel_at_.assign(static_cast<size_t>(width_) * height_, -1);
+}
+
+void HoughLineDetector::FindEdgePixels(const cv::Mat& grey) {
   if (options_.blur_sigma > 0.0) {
     cv::GaussianBlur(grey, smoothed_, cv::Size(0, 0), options_.blur_sigma);
   } else {
@@ -253,8 +254,9 @@ std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
   used_.assign(pixels_.size(), 0);
   seen_stamp_.assign(pixels_.size(), 0);
   stamp_ = 0;
+}
 
-  // Votes, limited to the normals within the orientation window of each pixel's gradient.
+void HoughLineDetector::Vote() {
   std::fill(accumulator_.begin(), accumulator_.end(), 0);
   const int half_window =
       static_cast<int>(std::floor(options_.orientation_window_deg / options_.theta_step_deg));
@@ -267,20 +269,19 @@ std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
       ++accumulator_[static_cast<size_t>(kk) * n_rho_ + std::lround(r + rho_max_)];
     }
   }
+}
 
-  // Local maxima of the accumulator (theta wraps with rho mirrored), strongest first.
-  struct Peak {
-    int votes, k, r;
-  };
+int HoughLineDetector::VotesAt(int k, int r) const {
+  if (k < 0 || k >= n_theta_) {
+    k = (k + n_theta_) % n_theta_;
+    r = n_rho_ - 1 - r;
+  }
+  if (r < 0 || r >= n_rho_) return 0;
+  return accumulator_[static_cast<size_t>(k) * n_rho_ + r];
+}
+
+std::vector<HoughLineDetector::Peak> HoughLineDetector::FindPeaks() const {
   std::vector<Peak> peaks;
-  auto at = [&](int k, int r) {
-    if (k < 0 || k >= n_theta_) {
-      k = (k + n_theta_) % n_theta_;
-      r = n_rho_ - 1 - r;
-    }
-    if (r < 0 || r >= n_rho_) return 0;
-    return accumulator_[static_cast<size_t>(k) * n_rho_ + r];
-  };
   for (int k = 0; k < n_theta_; ++k) {
     const int* row = &accumulator_[static_cast<size_t>(k) * n_rho_];
     for (int r = 0; r < n_rho_; ++r) {
@@ -290,7 +291,7 @@ std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
       for (int dk = -1; dk <= 1 && is_max; ++dk) {
         for (int dr = -1; dr <= 1 && is_max; ++dr) {
           if (dk == 0 && dr == 0) continue;
-          const int w = at(k + dk, r + dr);
+          const int w = VotesAt(k + dk, r + dr);
           // Plateaus: the first cell in scan order wins.
           is_max = v > w || (v == w && (dk > 0 || (dk == 0 && dr > 0)));
         }
@@ -302,9 +303,16 @@ std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
     return a.votes != b.votes ? a.votes > b.votes : (a.k != b.k ? a.k < b.k : a.r < b.r);
   });
   if (static_cast<int>(peaks.size()) > options_.max_peaks) peaks.resize(options_.max_peaks);
+  return peaks;
+}
 
+std::vector<Segment2> HoughLineDetector::Detect(const cv::Mat& grey) {
+  CV_Assert(grey.type() == CV_8UC1 && !grey.empty());
+  Resize(grey);
+  FindEdgePixels(grey);
+  Vote();
   std::vector<Segment2> segments;
-  for (const Peak& peak : peaks) {
+  for (const Peak& peak : FindPeaks()) {
     // Votes of pixels already explained by stronger lines have been withdrawn.
     if (accumulator_[static_cast<size_t>(peak.k) * n_rho_ + peak.r] < options_.min_votes) continue;
     ExtractChains(peak.k * options_.theta_step_deg, peak.r - rho_max_, &segments);

@@ -49,6 +49,21 @@ class HoughLineDetector {
     int x = 0, y = 0;
     float theta_deg = 0.0f;  // gradient direction modulo 180 degrees (the line's normal angle)
   };
+  // A local maximum of the accumulator: its votes, normal-angle bin k and offset bin r.
+  struct Peak {
+    int votes, k, r;
+  };
+  // Sizes the accumulator and the tables for images of `grey`'s size (kept between images).
+  void Resize(const cv::Mat& grey);
+  // Canny edges of `grey` into pixels_, with their gradient orientation.
+  void FindEdgePixels(const cv::Mat& grey);
+  // Fills the accumulator: each edge pixel votes for the normals within the orientation window
+  // of its gradient.
+  void Vote();
+  // Accumulator cell (k, r), theta wrapping with rho mirrored; 0 outside.
+  int VotesAt(int k, int r) const;
+  // Local maxima of the accumulator with at least min_votes, strongest first, at most max_peaks.
+  std::vector<Peak> FindPeaks() const;
   // Edge pixels within `tolerance` of the line (normal angle theta, offset rho from the image
   // centre) and orientation-compatible, ordered along the line.
   void Walk(double theta_deg, double rho, double tolerance, std::vector<int>* hits,

@@ -137,7 +137,7 @@ LineExtractor::LineExtractor(const LineExtractionOptions& options,
         impl_->fld = cv::ximgproc::createFastLineDetector(
             static_cast<int>(std::ceil(options.fragment_min_length_px)),
             static_cast<float>(options.fld.distance_px), options.fld.canny_low,
-            options.fld.canny_high, 3, false);
+            options.fld.canny_high, /*canny_aperture_size=*/3, /*do_merge=*/false);
         break;
       case LineDetectorKind::kEdlines: {
         impl_->edlines = cv::ximgproc::createEdgeDrawing();

@@ -46,21 +46,11 @@ struct Aabb {
 };
 
 bool FreeAt(const NavigableArea& area, const Eigen::Vector3d& p) {
-  const Eigen::Vector2d q = p.head<2>();
-  if (!area.outer().Contains(q)) return false;
-  for (const Polygon2& hole : area.holes()) {
-    if (hole.Contains(q)) return false;
-  }
-  return true;
+  return area.InsideBoundary(p.head<2>());
 }
 
 RenderSurface Solid(std::vector<Eigen::Vector3d> polygon, double albedo, bool decal = false) {
-  RenderSurface s;
-  s.kind = SurfaceKind::kClutter;
-  s.normal = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]).normalized();
-  s.offset = s.normal.dot(polygon[0]);
-  s.polygon = std::move(polygon);
-  s.albedo = std::clamp(albedo, 0.0, 1.0);
+  RenderSurface s = PlanarSurface(std::move(polygon), SurfaceKind::kClutter, albedo);
   s.decal = decal;
   return s;
 }
@@ -69,7 +59,8 @@ RenderSurface Solid(std::vector<Eigen::Vector3d> polygon, double albedo, bool de
 RenderSurface Band(const RenderSurface& host, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
                    double width, double albedo) {
   const Eigen::Vector3d across = host.normal.cross((q - p).normalized()) * (0.5 * width);
-  RenderSurface band = Solid({p - across, q - across, q + across, p + across}, albedo, true);
+  RenderSurface band =
+      Solid({p - across, q - across, q + across, p + across}, albedo, /*decal=*/true);
   band.normal = host.normal;  // the host's exact plane, so the decal depth test matches bit for bit
   band.offset = host.offset;
   return band;
@@ -166,7 +157,7 @@ bool TryPlace(const Wall& w, double clearance, SeededDraws* draws, Item* item) {
   item->surfaces = {Solid({p(s0, z0), p(s1, z0), p(s1, z1), p(s0, z1)}, albedo)};
   RenderSurface inner =
       Solid({p(s0 + m, z0 + m), p(s1 - m, z0 + m), p(s1 - m, z1 - 2 * m), p(s0 + m, z1 - 2 * m)},
-            picture, true);
+            picture, /*decal=*/true);
   inner.normal = item->surfaces[0].normal;
   inner.offset = item->surfaces[0].offset;
   item->surfaces.push_back(inner);

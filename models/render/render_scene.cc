@@ -45,7 +45,24 @@ bool RenderSceneOptions::Check(std::string* why) const {
     *why = "clutter_margin must be in [0, 5) metres";
     return false;
   }
+  for (const RenderSurface& s : extra_surfaces) {
+    if (s.polygon.size() < 3 || !(std::abs(s.normal.norm() - 1.0) < 1e-9) ||
+        !(s.albedo >= 0.0 && s.albedo <= 1.0)) {
+      *why = "an extra surface needs 3 corners, a unit normal and an albedo in [0, 1]";
+      return false;
+    }
+  }
   return true;
+}
+
+RenderSurface PlanarSurface(std::vector<Eigen::Vector3d> polygon, SurfaceKind kind, double albedo) {
+  RenderSurface s;
+  s.kind = kind;
+  s.normal = (polygon[1] - polygon[0]).cross(polygon[2] - polygon[0]).normalized();
+  s.offset = s.normal.dot(polygon[0]);
+  s.polygon = std::move(polygon);
+  s.albedo = std::clamp(albedo, 0.0, 1.0);
+  return s;
 }
 
 double FaceAlbedo(int face, bool outer_wall, uint64_t seed) {
@@ -100,6 +117,8 @@ RenderScene BuildRenderScene(const WireframeModel& model, const RenderSceneOptio
         FrameDecals(model, group, albedo[group.host_face], options.frame_width, options.seed);
     scene.surfaces.insert(scene.surfaces.end(), decals.begin(), decals.end());
   }
+  scene.surfaces.insert(scene.surfaces.end(), options.extra_surfaces.begin(),
+                        options.extra_surfaces.end());
 
   const int nx = std::max(1, static_cast<int>(std::lround((hi.x() - lo.x()) / kLightSpacing)));
   const int ny = std::max(1, static_cast<int>(std::lround((hi.y() - lo.y()) / kLightSpacing)));

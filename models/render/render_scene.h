@@ -21,6 +21,8 @@ enum class SurfaceKind {
   kDoorLeaf,    // the region inside a jamb-lintel-jamb chain
   kWindowPane,  // the region inside a closed loop of lines
   kClutter,     // unmodelled objects: boxes, cabinets, posters
+  kPerson,      // people walking through the scene (moving occluders)
+  kBoard,       // a calibration board and its squares (board_surfaces.h)
 };
 
 // One planar surface. Decals are painted onto the coplanar surface already visible (same plane,
@@ -32,7 +34,8 @@ struct RenderSurface {
   double offset = 0.0;
   double albedo = 0.5;  // reflectance in [0, 1]
   bool decal = false;
-  int model_face = -1;  // index into WireframeModel::faces() (kModelFace, and a decal's host)
+  int model_face = -1;        // index into WireframeModel::faces() (kModelFace, and a decal's host)
+  double texture_gain = 1.0;  // multiplies the renderer's texture contrast on this surface
 };
 
 struct RenderSceneOptions {
@@ -40,6 +43,8 @@ struct RenderSceneOptions {
   double frame_width = 0.07;     // width of door and window frame bands (metres)
   int clutter = 0;               // number of unmodelled objects to place
   double clutter_margin = 0.15;  // free space kept around doors, windows and other clutter (m)
+  // Surfaces added as given after the model's: a calibration board (board_surfaces.h).
+  std::vector<RenderSurface> extra_surfaces;
 
   bool Check(std::string* why) const;
 };
@@ -60,6 +65,10 @@ constexpr int kCeilingSurface = 1;
 // needed only for clutter (throws InputError naming the model when clutter is asked without it).
 RenderScene BuildRenderScene(const WireframeModel& model, const RenderSceneOptions& options,
                              const NavigableArea* free_space = nullptr);
+
+// A solid surface of `kind` on the plane of `polygon` (its normal by the right-hand rule on the
+// first three corners, which must not be collinear), the albedo clamped to [0, 1].
+RenderSurface PlanarSurface(std::vector<Eigen::Vector3d> polygon, SurfaceKind kind, double albedo);
 
 // Albedo of model face `face` for `seed`: faces on the model's bounding box (outer walls) in
 // [0.60, 0.80], inner faces (pillars, partitions) in [0.32, 0.52], consecutive indices apart by

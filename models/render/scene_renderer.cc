@@ -22,6 +22,7 @@ constexpr double kFineTextureCell = 0.2;    // metres per lattice cell of the fi
 constexpr double kMaxCanvasGrowth = 4.0;    // largest undistorted canvas / image area
 constexpr float kBackground = 60.0f;        // grey level where no surface is seen
 constexpr int kShadeStep = 4;               // pixels between exact shading evaluations
+constexpr float kCoveredLevel = 4.0f;       // grey level of a frame taken with the lens covered
 
 // Pinhole of a grid of samples: sample (i, j) centred at integer coordinates.
 struct SampleCamera {
@@ -34,6 +35,7 @@ struct SurfaceShading {
   Eigen::Vector3d normal, e1, e2;
   double albedo = 0.5;
   double s_offset = 0.0, t_offset = 0.0;  // where the surface reads the noise lattice
+  double texture_contrast = 0.0;
 };
 
 }  // namespace
@@ -43,6 +45,7 @@ struct SceneRenderer::Impl {
   RenderOptions options;
   RenderScene scene;
   std::vector<SurfaceShading> shading;
+  size_t static_surfaces = 0;  // surfaces of the scene itself; moving ones follow
   ValueNoise noise{0};
   // The undistorted canvas the scene is rendered into before distortion: canvas pixel (x, y)
   // is undistorted pixel (x + canvas_u, y + canvas_v) of the camera.
@@ -72,6 +75,12 @@ struct SceneRenderer::Impl {
   // Shades canvas pixels [x_begin, x_end) of row y, all showing surface `id` in every sample.
   void ShadeRun(uint16_t id, int y, int x_begin, int x_end, int k, float* out) const;
   void ShadeCanvas(int k);
+  // Shading constants of surface `s` (texture placed from the seed and the id).
+  SurfaceShading ShadingOf(size_t s) const;
+  // The undistorted canvas seen from `cam_from_world` (rasterised and shaded into `canvas`).
+  void RenderCanvas(const Eigen::Isometry3d& cam_from_world);
+  // Distortion, blur, gain and sensor noise of a canvas; the 8-bit image.
+  vpImage<unsigned char> FormImage(const cv::Mat& canvas_in, double gain, int frame_index);
   // Sizes the undistorted canvas to hold every output pixel's undistorted position, and
   // builds the distortion map (CameraIntrinsics::Undistort of each output pixel).
   void PrepareCanvas();
@@ -93,7 +102,7 @@ void SceneRenderer::Impl::Rasterize(const Eigen::Isometry3d& cam_from_world,
     const RenderSurface& surface = scene.surfaces[s];
     // Plane n . X = d in the world: (R n) . X_cam = d - n . C in the camera.
     facing[s] = PlaneInverseDepth(r * surface.normal, surface.offset - surface.normal.dot(centre),
-                                  cam.px, cam.py, cam.u0, cam.v0, &coeffs[s]);
+                                  {cam.px, cam.py, cam.u0, cam.v0}, &coeffs[s]);
   }
   zbuffer.Resize(cam.width, cam.height);
   zbuffer.ClearToPlanes(
@@ -134,7 +143,7 @@ double SceneRenderer::Impl::Reflectance(uint16_t id, const Eigen::Vector3d& x) c
   const double s = sh.e1.dot(x) + sh.s_offset, t = sh.e2.dot(x) + sh.t_offset;
   const double texture = 0.6 * noise(s / kCoarseTextureCell, t / kCoarseTextureCell) +
                          0.4 * noise(s / kFineTextureCell + 97.0, t / kFineTextureCell + 31.0);
-  return 255.0 * options.exposure * sh.albedo * (1.0 + options.texture_contrast * texture);
+  return 255.0 * options.exposure * sh.albedo * (1.0 + sh.texture_contrast * texture);
 }
 
 double SceneRenderer::Impl::Light(uint16_t id, const Eigen::Vector3d& x) const {
@@ -252,6 +261,72 @@ void SceneRenderer::Impl::PrepareCanvas() {
   }
 }
 
+SurfaceShading SceneRenderer::Impl::ShadingOf(size_t s) const {
+  const RenderSurface& surface = scene.surfaces[s];
+  SurfaceShading sh;
+  sh.normal = surface.normal;
+  PlaneBasis(surface.normal, &sh.e1, &sh.e2);
+  sh.albedo = surface.albedo;
+  const uint64_t h = HashCombine(options.scene.seed, s);
+  sh.s_offset = 256.0 * kCoarseTextureCell * HashUnit(h);
+  sh.t_offset = 256.0 * kCoarseTextureCell * HashUnit(HashMix(h));
+  sh.texture_contrast = options.texture_contrast * surface.texture_gain;
+  return sh;
+}
+
+void SceneRenderer::Impl::RenderCanvas(const Eigen::Isometry3d& cam_from_world) {
+  const int k = options.supersample;
+  // Sample (i, j) of the supersampled canvas sits at canvas pixel ((i + 0.5) / k - 0.5, ...).
+  SampleCamera cam;
+  cam.px = k * camera.px;
+  cam.py = k * camera.py;
+  cam.u0 = k * (camera.u0 - canvas_u + 0.5) - 0.5;
+  cam.v0 = k * (camera.v0 - canvas_v + 0.5) - 0.5;
+  cam.width = k * canvas_width;
+  cam.height = k * canvas_height;
+  Rasterize(cam_from_world, cam);
+  ShadeCanvas(k);
+}
+
+vpImage<unsigned char> SceneRenderer::Impl::FormImage(const cv::Mat& canvas_in, double gain,
+                                                      int frame_index) {
+  cv::Mat image = canvas_in;
+  if (distort) {
+    cv::remap(canvas_in, blurred, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    image = blurred.clone();
+  }
+  if (options.blur_sigma > 0.0) {
+    cv::GaussianBlur(image, blurred, cv::Size(0, 0), options.blur_sigma, options.blur_sigma,
+                     cv::BORDER_REPLICATE);
+    image = blurred;
+  }
+  if (gain != 1.0) image = image * gain;
+  if (options.noise_sigma > 0.0) {
+    cv::RNG rng(HashCombine(options.scene.seed, 0x5e4504ull + static_cast<uint64_t>(frame_index)));
+    sensor_noise.create(image.size(), CV_32F);
+    rng.fill(sensor_noise, cv::RNG::NORMAL, 0.0, options.noise_sigma);
+    image = image + sensor_noise;
+  }
+  cv::Mat grey;
+  image.convertTo(grey, CV_8U);  // rounds and saturates
+  vpImage<unsigned char> out(static_cast<unsigned>(grey.rows), static_cast<unsigned>(grey.cols));
+  for (int v = 0; v < grey.rows; ++v)
+    std::memcpy(out[v], grey.ptr<unsigned char>(v), grey.cols);
+  return out;
+}
+
+bool FrameExposure::Check(std::string* why) const {
+  if (shutter.empty() && !covered) {
+    *why = "an exposure needs at least one camera pose";
+    return false;
+  }
+  if (!(gain > 0.0 && gain <= 100.0)) {
+    *why = "the exposure gain must be in (0, 100]";
+    return false;
+  }
+  return true;
+}
+
 bool RenderOptions::Check(std::string* why) const {
   if (!scene.Check(why)) return false;
   if (supersample < 1 || supersample > 4) {
@@ -290,17 +365,9 @@ SceneRenderer::SceneRenderer(const WireframeModel& model, const CameraIntrinsics
     throw InputError(Located(model.path(), 0, "too many surfaces to render"));
   }
   m.noise = ValueNoise(HashCombine(options.scene.seed, 0x7e47u));
-  for (size_t s = 0; s < m.scene.surfaces.size(); ++s) {
-    const RenderSurface& surface = m.scene.surfaces[s];
-    SurfaceShading sh;
-    sh.normal = surface.normal;
-    PlaneBasis(surface.normal, &sh.e1, &sh.e2);
-    sh.albedo = surface.albedo;
-    const uint64_t h = HashCombine(options.scene.seed, s);
-    sh.s_offset = 256.0 * kCoarseTextureCell * HashUnit(h);
-    sh.t_offset = 256.0 * kCoarseTextureCell * HashUnit(HashMix(h));
-    m.shading.push_back(sh);
-  }
+  m.static_surfaces = m.scene.surfaces.size();
+  for (size_t s = 0; s < m.scene.surfaces.size(); ++s)
+    m.shading.push_back(m.ShadingOf(s));
 
   m.PrepareCanvas();
 }
@@ -318,41 +385,46 @@ const CameraIntrinsics& SceneRenderer::camera() const {
 vpImage<unsigned char> SceneRenderer::Render(const Eigen::Isometry3d& cam_from_world,
                                              int frame_index) {
   Impl& m = *impl_;
-  const int k = m.options.supersample;
-  // Sample (i, j) of the supersampled canvas sits at canvas pixel ((i + 0.5) / k - 0.5, ...).
-  SampleCamera cam;
-  cam.px = k * m.camera.px;
-  cam.py = k * m.camera.py;
-  cam.u0 = k * (m.camera.u0 - m.canvas_u + 0.5) - 0.5;
-  cam.v0 = k * (m.camera.v0 - m.canvas_v + 0.5) - 0.5;
-  cam.width = k * m.canvas_width;
-  cam.height = k * m.canvas_height;
-  m.Rasterize(cam_from_world, cam);
-  m.ShadeCanvas(k);
+  m.RenderCanvas(cam_from_world);
+  return m.FormImage(m.canvas, 1.0, frame_index);
+}
 
-  cv::Mat image = m.canvas;
-  if (m.distort) {
-    cv::remap(m.canvas, m.blurred, m.map_x, m.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-    image = m.blurred.clone();
+vpImage<unsigned char> SceneRenderer::Render(const FrameExposure& exposure) {
+  std::string why;
+  if (!exposure.Check(&why)) throw InputError("render: " + why);
+  Impl& m = *impl_;
+  if (exposure.covered) {
+    const cv::Mat dark(m.canvas_height, m.canvas_width, CV_32F, cv::Scalar(kCoveredLevel));
+    return m.FormImage(dark, 1.0, exposure.frame_index);
   }
-  if (m.options.blur_sigma > 0.0) {
-    cv::GaussianBlur(image, m.blurred, cv::Size(0, 0), m.options.blur_sigma, m.options.blur_sigma,
-                     cv::BORDER_REPLICATE);
-    image = m.blurred;
+  if (exposure.shutter.size() == 1) {
+    m.RenderCanvas(exposure.shutter.front());
+    return m.FormImage(m.canvas, exposure.gain, exposure.frame_index);
   }
-  if (m.options.noise_sigma > 0.0) {
-    cv::RNG rng(
-        HashCombine(m.options.scene.seed, 0x5e4504ull + static_cast<uint64_t>(frame_index)));
-    m.sensor_noise.create(image.size(), CV_32F);
-    rng.fill(m.sensor_noise, cv::RNG::NORMAL, 0.0, m.options.noise_sigma);
-    image = image + m.sensor_noise;
+  cv::Mat sum;
+  for (const Eigen::Isometry3d& pose : exposure.shutter) {
+    m.RenderCanvas(pose);
+    if (sum.empty()) {
+      sum = m.canvas.clone();
+    } else {
+      sum += m.canvas;
+    }
   }
-  cv::Mat grey;
-  image.convertTo(grey, CV_8U);  // rounds and saturates
-  vpImage<unsigned char> out(static_cast<unsigned>(grey.rows), static_cast<unsigned>(grey.cols));
-  for (int v = 0; v < grey.rows; ++v)
-    std::memcpy(out[v], grey.ptr<unsigned char>(v), grey.cols);
-  return out;
+  sum *= 1.0 / static_cast<double>(exposure.shutter.size());
+  return m.FormImage(sum, exposure.gain, exposure.frame_index);
+}
+
+void SceneRenderer::SetMovingSurfaces(const std::vector<RenderSurface>& surfaces) {
+  Impl& m = *impl_;
+  if (m.static_surfaces + surfaces.size() >= ZBuffer::kNoSurface) {
+    throw InputError("render: too many moving surfaces");
+  }
+  m.scene.surfaces.resize(m.static_surfaces);
+  m.shading.resize(m.static_surfaces);
+  for (const RenderSurface& surface : surfaces) {
+    m.scene.surfaces.push_back(surface);
+    m.shading.push_back(m.ShadingOf(m.scene.surfaces.size() - 1));
+  }
 }
 
 SurfaceMap SceneRenderer::RenderSurfaces(const Eigen::Isometry3d& cam_from_world) {

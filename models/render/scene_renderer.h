@@ -41,6 +41,17 @@ struct SurfaceMap {
   float DepthAt(int u, int v) const { return depth[static_cast<size_t>(v) * width + u]; }
 };
 
+// How one frame of a sequence is exposed: the camera's poses over the shutter time (their images
+// are averaged: motion blur along the image motion), the gain of the exposure, a covered lens.
+struct FrameExposure {
+  std::vector<Eigen::Isometry3d> shutter;  // cam_from_world at instants across the shutter time
+  double gain = 1.0;     // multiplies the image before the sensor noise (then saturates at 255)
+  bool covered = false;  // lens covered: a dark uniform frame with the sensor noise
+  int frame_index = 0;   // picks the sensor-noise draw
+
+  bool Check(std::string* why) const;
+};
+
 // Renders views of one scene with one camera; keeps its buffers between calls (not thread-safe:
 // use one renderer per thread).
 class SceneRenderer {
@@ -57,10 +68,18 @@ class SceneRenderer {
   // picks the sensor-noise draw (seeded by the options' seed and the index).
   vpImage<unsigned char> Render(const Eigen::Isometry3d& cam_from_world, int frame_index = 0);
 
-  // Surface and depth at each pixel centre of the undistorted image, without supersampling.
+  // One frame of a sequence (throws InputError when the exposure is invalid).
+  vpImage<unsigned char> Render(const FrameExposure& exposure);
+
+  // Surfaces that move from frame to frame (people), drawn with the scene until replaced: they
+  // follow the scene's own in scene().surfaces.
+  void SetMovingSurfaces(const std::vector<RenderSurface>& surfaces);
+
+  // Surface and depth at each pixel centre of the undistorted image, without supersampling
+  // (moving surfaces included).
   SurfaceMap RenderSurfaces(const Eigen::Isometry3d& cam_from_world);
 
-  const RenderScene& scene() const;
+  const RenderScene& scene() const;  // the static scene, then the moving surfaces
   const CameraIntrinsics& camera() const;
 
  private:

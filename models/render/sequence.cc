@@ -29,9 +29,11 @@ std::vector<Segment2> Obstacles(const NavigableArea& area) {
       out.push_back({ring.vertices[i], ring.vertices[(i + 1) % ring.vertices.size()]});
     }
   };
-  add_ring(area.outer());
-  for (const Polygon2& hole : area.holes())
-    add_ring(hole);
+  for (const AreaPart& part : area.parts()) {
+    add_ring(part.outer);
+    for (const Polygon2& hole : part.holes)
+      add_ring(hole);
+  }
   return out;
 }
 
@@ -66,11 +68,26 @@ Eigen::Vector2d AtArcLength(const std::vector<Eigen::Vector2d>& loop, double ste
   return (1.0 - a) * loop[i] + a * loop[(i + 1) % loop.size()];
 }
 
+// Translation from pose a to pose b expressed in a's frame (x forward, y left).
+Eigen::Vector2d RelativeMotion(const Pose3Dof& a, const Pose3Dof& b) {
+  const Eigen::Vector2d d(b.x - a.x, b.y - a.y);
+  const double c = std::cos(a.heading), s = std::sin(a.heading);
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
+}
+
 double LoopLength(const std::vector<Eigen::Vector2d>& loop) {
   double length = 0.0;
   for (size_t i = 0; i < loop.size(); ++i)
     length += (loop[(i + 1) % loop.size()] - loop[i]).norm();
   return length;
+}
+
+// Sample position f (in steps) of an open path of `size` points, clamped to its ends: index
+// of the segment and fraction along it.
+void OpenPathSample(size_t size, double f, size_t* i, double* a) {
+  f = std::clamp(f, 0.0, static_cast<double>(size - 1));
+  *i = std::min(static_cast<size_t>(f), size - 2);
+  *a = f - static_cast<double>(*i);
 }
 
 }  // namespace
@@ -175,26 +192,104 @@ bool DriveOptions::Check(std::string* why) const {
     *why = "pan and tilt periods must be positive (seconds)";
     return false;
   }
+  if (!(pan_rate >= 0.0 && pan_rate <= 4.0 * kPi)) {
+    *why = "pan rate must be in [0, 720] deg/s";
+    return false;
+  }
   return true;
+}
+
+double HeadPanAt(const DriveOptions& options, double t) {
+  if (options.pan_rate > 0.0 && options.pan_amplitude > 0.0) {
+    const double period = 4.0 * options.pan_amplitude / options.pan_rate;
+    const double phase = t / period - std::floor(t / period);  // [0, 1)
+    const double wave = phase < 0.25   ? 4.0 * phase
+                        : phase < 0.75 ? 2.0 - 4.0 * phase
+                                       : 4.0 * phase - 4.0;
+    return options.pan_amplitude * wave;
+  }
+  return options.pan_amplitude * std::sin(2.0 * kPi * t / options.pan_period);
+}
+
+SampledPath SampledPath::Through(std::vector<Eigen::Vector2d> points, bool closed) {
+  if (points.size() < 2) throw InputError("path: fewer than two points");
+  SampledPath path;
+  path.points = std::move(points);
+  path.closed = closed;
+  path.step = path.Length() / (closed ? path.points.size() : path.points.size() - 1);
+  return path;
+}
+
+double SampledPath::Length() const {
+  if (points.size() < 2) return 0.0;
+  if (closed) return LoopLength(points);
+  double length = 0.0;
+  for (size_t i = 0; i + 1 < points.size(); ++i)
+    length += (points[i + 1] - points[i]).norm();
+  return length;
+}
+
+Eigen::Vector2d SampledPath::PointAt(double s) const {
+  if (closed) return AtArcLength(points, step, s);
+  size_t i = 0;
+  double a = 0.0;
+  OpenPathSample(points.size(), s / step, &i, &a);
+  return (1.0 - a) * points[i] + a * points[i + 1];
+}
+
+double SampledPath::DirectionAt(double s) const {
+  const Eigen::Vector2d tangent = PointAt(s + kTangentHalfSpan) - PointAt(s - kTangentHalfSpan);
+  return std::atan2(tangent.y(), tangent.x());
+}
+
+double SampledPath::HeadingOffsetAt(double s) const {
+  const std::vector<HeadingKnot>& k = heading_knots;
+  if (k.empty()) return 0.0;
+  if (closed) {
+    const double length = Length();
+    s = std::fmod(s, length);
+    if (s < 0.0) s += length;
+  }
+  if (s <= k.front().s) return k.front().offset;
+  if (s >= k.back().s) return k.back().offset;
+  const auto next = std::upper_bound(k.begin(), k.end(), s,
+                                     [](double v, const HeadingKnot& h) { return v < h.s; });
+  const HeadingKnot& a = *(next - 1);
+  const HeadingKnot& b = *next;
+  return a.offset + (s - a.s) / (b.s - a.s) * (b.offset - a.offset);
 }
 
 std::vector<SequenceFrame> DriveAlongLoop(const std::vector<Eigen::Vector2d>& loop,
                                           const DriveOptions& options) {
-  const double length = LoopLength(loop);
-  const double step = length / loop.size();
+  return DriveAlongPath(SampledPath::Through(loop, /*closed=*/true), options);
+}
+
+std::vector<SequenceFrame> DriveAlongPath(const SampledPath& path, const DriveOptions& options) {
+  if (path.points.size() < 2 || !(path.step > 0.0)) {
+    throw InputError("path: fewer than two distinct points");
+  }
+  const double length = path.Length();
   const double per_frame = options.speed / options.fps;
-  const int frames =
-      options.frames > 0 ? options.frames : std::max(1, static_cast<int>(length / per_frame));
+  int frames = options.frames;
+  if (frames <= 0) {
+    frames = path.closed ? std::max(1, static_cast<int>(length / per_frame))
+                         : static_cast<int>(length / per_frame + 1e-9) + 1;
+  }
+  if (!path.closed && (frames - 1) * per_frame > length + 1e-9) {
+    throw InputError("path: it is " + std::to_string(length) + " m long, " +
+                     std::to_string(static_cast<int>(length / per_frame + 1e-9) + 1) +
+                     " frames at most at this speed and frame rate");
+  }
   std::vector<SequenceFrame> out;
   for (int f = 0; f < frames; ++f) {
     SequenceFrame frame;
     frame.t = f / options.fps;
     const double s = f * per_frame;
-    const Eigen::Vector2d p = AtArcLength(loop, step, s);
-    const Eigen::Vector2d tangent = AtArcLength(loop, step, s + kTangentHalfSpan) -
-                                    AtArcLength(loop, step, s - kTangentHalfSpan);
-    frame.base = {p.x(), p.y(), std::atan2(tangent.y(), tangent.x()), options.height, 0.0};
-    frame.pan = options.pan_amplitude * std::sin(2.0 * kPi * frame.t / options.pan_period);
+    const Eigen::Vector2d p = path.PointAt(s);
+    double heading = path.DirectionAt(s);
+    if (!path.heading_knots.empty()) heading = WrapAngle(heading + path.HeadingOffsetAt(s));
+    frame.base = {p.x(), p.y(), heading, options.height, 0.0};
+    frame.pan = HeadPanAt(options, frame.t);
     frame.camera = frame.base;
     frame.camera.heading = WrapAngle(frame.base.heading + frame.pan);
     frame.camera.tilt =
@@ -226,6 +321,10 @@ bool OdometryOptions::Check(std::string* why) const {
       return false;
     }
   }
+  if (!(std::abs(scale_error) < 0.5) || !(std::abs(heading_drift) < 1.0)) {
+    *why = "the odometry's scale error must be in (-0.5, 0.5) and heading drift in (-1, 1) rad/m";
+    return false;
+  }
   return true;
 }
 
@@ -234,8 +333,10 @@ std::vector<PriorRecord> SimulateOdometryPriors(const std::vector<SequenceFrame>
   std::vector<PriorRecord> out;
   if (frames.empty()) return out;
   SeededDraws draws(HashCombine(options.seed, 0x0d0e7e4ull));
-  const double scale = 1.0 + options.scale_bias * draws.Normal();
-  const double drift = options.heading_bias * draws.Normal();  // radians per metre
+  double scale = 1.0 + options.scale_bias * draws.Normal();
+  double drift = options.heading_bias * draws.Normal();  // radians per metre
+  if (options.scale_error != 0.0) scale += options.scale_error;
+  if (options.heading_drift != 0.0) drift += options.heading_drift;
   RobotPose odometry = frames.front().base;
   for (size_t k = 0; k < frames.size(); ++k) {
     if (k > 0) {
@@ -263,6 +364,57 @@ std::vector<PriorRecord> SimulateOdometryPriors(const std::vector<SequenceFrame>
                    frames[k].camera.height, frames[k].camera.tilt};
     out.push_back(record);
   }
+  return out;
+}
+
+OdometryOptions OdometryForDrift(double drift, uint64_t seed) {
+  OdometryOptions options;
+  options.seed = seed;
+  options.scale_bias = 0.0;
+  options.heading_bias = 0.0;
+  options.heading_walk = 0.002;
+  SeededDraws signs(HashCombine(seed, 0xd21f7ull));
+  options.scale_error = (signs.Unit() < 0.5 ? -0.9 : 0.9) * drift;
+  options.heading_drift = (signs.Unit() < 0.5 ? -0.02 : 0.02) * drift;
+  return options;
+}
+
+OdometryDrift MeasureOdometryDrift(const std::vector<SequenceFrame>& frames,
+                                   const std::vector<PriorRecord>& priors, double window_m) {
+  OdometryDrift out;
+  out.window_m = window_m;
+  const size_t n = std::min(frames.size(), priors.size());
+  if (n < 2) return out;
+  std::vector<double> travelled(n, 0.0);  // along the true path
+  for (size_t k = 1; k < n; ++k) {
+    travelled[k] = travelled[k - 1] + std::hypot(frames[k].base.x - frames[k - 1].base.x,
+                                                 frames[k].base.y - frames[k - 1].base.y);
+  }
+  // Base poses: the prior's heading holds the (exact) head pan.
+  auto odometry = [&](size_t k) {
+    const RobotPose& p = priors[k].pose;
+    return Pose3Dof{p.x, p.y, WrapAngle(p.heading - frames[k].pan)};
+  };
+  auto truth = [&](size_t k) { return frames[k].base.Planar(); };
+  auto relative_error = [&](size_t a, size_t b) {
+    const Eigen::Vector2d d_odo = RelativeMotion(odometry(a), odometry(b));
+    const Eigen::Vector2d d_true = RelativeMotion(truth(a), truth(b));
+    return (d_odo - d_true).norm() / (travelled[b] - travelled[a]);
+  };
+  if (travelled[n - 1] > 0.0) out.whole_share = relative_error(0, n - 1);
+  double sum = 0.0;
+  size_t b = 0;
+  for (size_t a = 0; a < n; ++a) {
+    b = std::max(b, a);
+    while (b < n && travelled[b] - travelled[a] < window_m)
+      ++b;
+    if (b >= n) break;
+    const double share = relative_error(a, b);
+    out.max_share = std::max(out.max_share, share);
+    sum += share;
+    ++out.windows;
+  }
+  out.mean_share = out.windows > 0 ? sum / out.windows : 0.0;
   return out;
 }
 

@@ -5,8 +5,9 @@
 
 namespace linetrack {
 
-bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam, double px, double py,
-                       double u0, double v0, Eigen::Vector3d* coeffs) {
+bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam,
+                       const SamplePinhole& pinhole, Eigen::Vector3d* coeffs) {
+  const double px = pinhole.px, py = pinhole.py, u0 = pinhole.u0, v0 = pinhole.v0;
   // X = z (x, y, 1) with x = (i - u0) / px: n . X = d gives 1/z = n . (x, y, 1) / d.
   if (std::abs(offset_cam) < 1e-12) return false;
   const Eigen::Vector3d& n = normal_cam;

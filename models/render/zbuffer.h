@@ -9,11 +9,16 @@
 
 namespace linetrack {
 
+// A pinhole in sample units: sample (i, j) = (u0 + px X / Z, v0 + py Y / Z).
+struct SamplePinhole {
+  double px = 0.0, py = 0.0, u0 = 0.0, v0 = 0.0;
+};
+
 // Inverse depth of a plane n . X = d (camera frame) as an affine function of the sample
-// coordinates (i, j): 1/z = c.x i + c.y j + c.z, for a pinhole (px, py, u0, v0) in sample units.
-// False when the plane passes through the optical centre (seen edge-on).
-bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam, double px, double py,
-                       double u0, double v0, Eigen::Vector3d* coeffs);
+// coordinates (i, j): 1/z = c.x i + c.y j + c.z. False when the plane passes through the optical
+// centre (seen edge-on).
+bool PlaneInverseDepth(const Eigen::Vector3d& normal_cam, double offset_cam,
+                       const SamplePinhole& pinhole, Eigen::Vector3d* coeffs);
 
 // Sutherland-Hodgman clipping of a polygon (camera frame) to the half-space z >= near.
 std::vector<Eigen::Vector3d> ClipPolygonNear(const std::vector<Eigen::Vector3d>& polygon,

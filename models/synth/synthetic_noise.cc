@@ -60,6 +60,10 @@ bool SyntheticSceneOptions::Check(std::string* why) const {
     *why = "count: " + std::to_string(count) + " must be > 0";
     return false;
   }
+  if (storey < 0 || !std::isfinite(floor_z)) {
+    *why = "storey must be >= 0 and floor_z finite";
+    return false;
+  }
   if (!camera.Check(why)) return false;
   if (camera.width <= 0 || camera.height <= 0) {
     *why = "camera: the image size must be known";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "models/errors.h"
 
@@ -28,11 +29,11 @@ CameraIntrinsics ImageCamera(const CameraIntrinsics& nominal, double calibration
   return camera;
 }
 
-Eigen::Vector2d RandomPosition(const NavigableArea& area, SceneRandom* rng) {
-  const Eigen::Vector2d lo = area.BoundsMin(), hi = area.BoundsMax();
+Eigen::Vector2d RandomPosition(const NavigableArea& area, int storey, SceneRandom* rng) {
+  const Eigen::Vector2d lo = area.BoundsMin(storey), hi = area.BoundsMax(storey);
   for (int i = 0; i < kMaxPositionDraws; ++i) {
     const Eigen::Vector2d p(rng->Uniform(lo.x(), hi.x()), rng->Uniform(lo.y(), hi.y()));
-    if (area.Contains(p)) return p;
+    if (area.Contains(p, storey)) return p;
   }
   throw InputError(area.source() + ": no position of the navigable area found by sampling");
 }
@@ -65,10 +66,11 @@ std::vector<Segment2> MeasuredPieces(const Segment2& image, bool fragment,
 }
 
 // The image of a random unmodelled vertical segment standing on the floor in front of the
-// camera, visible (not behind a wall) and long enough; false when none was found.
-bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
-                         const OcclusionTester& occlusion, const NavigableArea& area,
-                         const SyntheticSceneOptions& o, SceneRandom* rng, Segment2* line) {
+// camera, visible (not behind a wall) and long enough; nullopt when none was found.
+std::optional<Segment2> VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
+                                            const OcclusionTester& occlusion,
+                                            const NavigableArea& area,
+                                            const SyntheticSceneOptions& o, SceneRandom* rng) {
   const Eigen::Isometry3d cam_from_world = CamFromWorld(truth);
   const double half_fov = std::atan2(0.5 * camera.width, camera.px);
   for (int i = 0; i < kMaxClutterDraws; ++i) {
@@ -78,8 +80,8 @@ bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
     const double top = rng->Uniform(o.vertical_clutter_height_min, o.vertical_clutter_height_max);
     const Eigen::Vector2d foot = Eigen::Vector2d(truth.x, truth.y) +
                                  distance * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
-    if (!area.InsideWalls(foot, kClutterWallMarginM)) continue;
-    Segment3 segment{{foot.x(), foot.y(), 0.0}, {foot.x(), foot.y(), top}};
+    if (!area.InsideWalls(foot, kClutterWallMarginM, o.storey)) continue;
+    Segment3 segment{{foot.x(), foot.y(), o.floor_z}, {foot.x(), foot.y(), o.floor_z + top}};
     if (!ClipToFrustum(cam_from_world, camera, EdgeProjectionOptions().near_clip, &segment) ||
         occlusion.Blocked(truth.Centre(), segment.a) ||
         occlusion.Blocked(truth.Centre(), segment.b)) {
@@ -89,10 +91,9 @@ bool VerticalClutterLine(const RobotPose& truth, const CameraIntrinsics& camera,
                          camera.Project(cam_from_world * segment.b)};
     const std::vector<Segment2> pieces = MeasuredPieces(image, false, o, rng);
     if (pieces.empty()) continue;
-    *line = pieces.front();
-    return true;
+    return pieces.front();
   }
-  return false;
+  return std::nullopt;
 }
 
 // A random image segment: midpoint uniform in the image, direction uniform, length uniform in
@@ -195,11 +196,11 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
                        " draws sees " + std::to_string(o.min_visible_edges) + " to " +
                        std::to_string(o.max_visible_edges) + " model edges");
     }
-    const Eigen::Vector2d position = RandomPosition(area, &rng);
+    const Eigen::Vector2d position = RandomPosition(area, o.storey, &rng);
     scene.truth.x = position.x();
     scene.truth.y = position.y();
     scene.truth.heading = rng.Uniform(-kPi, kPi);
-    scene.truth.height = rng.Uniform(o.height_min, o.height_max);
+    scene.truth.height = o.floor_z + rng.Uniform(o.height_min, o.height_max);
     scene.truth.tilt = rng.Uniform(o.tilt_min, o.tilt_max);
     scene.calibration_error = rng.Normal(o.calibration_sigma);
     camera = ImageCamera(o.camera, scene.calibration_error);
@@ -209,8 +210,11 @@ SyntheticScene GenerateScene(const WireframeModel& model, const OcclusionTester&
   const int vertical = static_cast<int>(std::lround(clutter * o.vertical_clutter_fraction));
   for (int k = 0; k < clutter; ++k) {
     LabelledLine line;
-    line.vertical_clutter = k < vertical && VerticalClutterLine(scene.truth, camera, occlusion,
-                                                                area, o, &rng, &line.line);
+    const std::optional<Segment2> vertical_line =
+        k < vertical ? VerticalClutterLine(scene.truth, camera, occlusion, area, o, &rng)
+                     : std::nullopt;
+    line.vertical_clutter = vertical_line.has_value();
+    if (vertical_line) line.line = *vertical_line;
     if (line.vertical_clutter || RandomClutterLine(o, &rng, &line.line)) lines.push_back(line);
   }
   const double radius = o.delta_t * std::sqrt(rng.Uniform(0.0, 1.0));

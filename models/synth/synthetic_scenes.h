@@ -34,8 +34,13 @@ PriorBounds QualityIndexBounds(int qi);
 struct SyntheticSceneOptions {
   uint64_t seed = 1;
   int count = 430;
-  // Pose ranges: height of the optical centre (metres) and tilt below the horizontal (radians).
+  // Pose ranges: height of the optical centre above the floor (metres) and tilt below the
+  // horizontal (radians).
   double height_min = 1.2, height_max = 1.5;
+  // The storey the camera stands on (an index into the area's storeys; poses are drawn in its
+  // parts) and the world z of its floor: scenes' heights are floor_z + the drawn height.
+  int storey = 0;
+  double floor_z = 0.0;
   double tilt_min = 0.0, tilt_max = DegToRad(10.0);
   // The nominal camera (what the case gives the matcher); the image is generated with
   // px, py scaled by (1 + eps_m), eps_m ~ N(0, calibration_sigma) per scene (Table 1, eta_m).
@@ -91,8 +96,8 @@ struct SyntheticScene {
   Pose3Dof prior;               // x, y (metres), heading (radians)
   double delta_t = 0.0;         // metres
   double delta_phi = 0.0;       // radians
-  double height = 0.0;          // metres (true, known to the matcher)
-  double tilt = 0.0;            // radians (true, known to the matcher)
+  double height = 0.0;  // world z of the optical centre, metres (true, known to the matcher)
+  double tilt = 0.0;    // radians (true, known to the matcher)
   RobotPose truth;
   std::vector<std::pair<int, int>> matches;  // (model edge id, line index), sorted
   std::vector<int> clutter;                  // indices of clutter lines, sorted

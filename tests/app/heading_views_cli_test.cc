@@ -1,13 +1,16 @@
-// `linetrack heading` and `linetrack views` end to end: the heading of a rendered hall view
-// (tilt given and estimated) and of exact lines, a view database built on a grid of the room
-// and read back, an image localised against it, and bad input (exit 2, one line, no output).
+// `linetrack heading`, `linetrack views` and `localize --global` end to end: the heading of a
+// rendered hall view (tilt given and estimated) and of exact lines, a view database built on a
+// grid of the room and read back, an image localised against it, the room localised with no
+// prior (lines, batch, image through the integrity gate), and bad input (exit 2, one line).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "models/occlusion.h"
 #include "models/robot_pose.h"
@@ -28,6 +31,17 @@ const std::string kCamera = kSource + "/tests/data/camera_paper.xml";
 const std::string kWideCamera = kSource + "/tests/data/camera_wide.xml";
 constexpr double kHeadingTolDeg = 1.0;  // the target for one candidate
 constexpr double kTiltTolDeg = 0.5;
+constexpr double kPositionTolM = 0.3;  // a correct answer (the benchmarks' tolerance)
+constexpr double kPoseHeadingTolDeg = 3.0;
+
+// The global answer's pose is the truth's (x, y, heading_deg).
+void ExpectPoseNear(const nlohmann::json& pose, double x, double y, double heading_deg) {
+  EXPECT_NEAR(pose["x"].get<double>(), x, kPositionTolM) << pose;
+  EXPECT_NEAR(pose["y"].get<double>(), y, kPositionTolM) << pose;
+  EXPECT_LT(std::abs(std::remainder(pose["heading_deg"].get<double>() - heading_deg, 360.0)),
+            kPoseHeadingTolDeg)
+      << pose;
+}
 
 double NearestCandidateDeg(const nlohmann::json& headings, double truth_deg) {
   double best = 360.0;
@@ -210,6 +224,116 @@ TEST_F(HeadingViewsCli, ViewsBadInputExitsTwoAndWritesNothing) {
   const CommandRun bad = Linetrack("views localize --lines " + csv + " --views " + db);
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("views.jsonl:"), std::string::npos) << bad.err;
+}
+
+// The room (a door, a window, a cabinet: no symmetry) from exact lines with no prior.
+TEST_F(HeadingViewsCli, LocalizeGlobalFindsTheRoomPoseFromLines) {
+  const std::string csv =
+      ExactLinesCsv(kRoom, {1.0, 1.0, DegToRad(45.0), 1.3, DegToRad(5.0)}, "room.csv");
+  const CommandRun run = Linetrack("localize --global --lines " + csv + " --model " + kRoom +
+                                   " --camera " + kCamera + " --height 1.3 --tilt 5 --json");
+  ASSERT_EQ(run.code, 0) << run.out << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j["global"].get<bool>());
+  EXPECT_TRUE(j["found"].get<bool>());
+  EXPECT_FALSE(j["ambiguous"].get<bool>());
+  EXPECT_TRUE(j["rivals"].empty());
+  EXPECT_LT(NearestCandidateDeg(j["headings_deg"], 45.0), kHeadingTolDeg);
+  ExpectPoseNear(j["pose"], 1.0, 1.0, 45.0);
+  EXPECT_EQ(j["edge_names"].size(), j["matches"].size());
+
+  const CommandRun text = Linetrack("localize --global --lines " + csv + " --model " + kRoom +
+                                    " --camera " + kCamera + " --height 1.3 --tilt 5");
+  EXPECT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("heading searches"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("pose      x "), std::string::npos) << text.out;
+}
+
+// A batch case without "prior", or with "prior": null, is global; one with a prior is not.
+TEST_F(HeadingViewsCli, LocalizeBatchCaseWithoutPriorIsGlobal) {
+  const std::string csv =
+      ExactLinesCsv(kRoom, {1.0, 1.0, DegToRad(45.0), 1.3, DegToRad(5.0)}, "room.csv");
+  nlohmann::json lines = nlohmann::json::array();
+  std::ifstream in(csv);
+  std::string row;
+  std::getline(in, row);  // header
+  while (std::getline(in, row)) {
+    double u1, v1, u2, v2;
+    char c;
+    std::istringstream(row) >> u1 >> c >> v1 >> c >> u2 >> c >> v2;
+    lines.push_back({u1, v1, u2, v2});
+  }
+  nlohmann::json base = {
+      {"model", kRoom}, {"camera", kCamera}, {"height", 1.3}, {"tilt", 5.0}, {"lines", lines}};
+  nlohmann::json null_prior = base, no_prior = base, prior = base;
+  null_prior["id"] = "null";
+  null_prior["prior"] = nullptr;
+  null_prior["delta_t"] = "ignored";
+  no_prior["id"] = "absent";
+  prior["id"] = "local";
+  prior["prior"] = {1.1, 1.1, 43.0};
+  prior["delta_t"] = 0.5;
+  prior["delta_phi"] = 10.0;
+  const std::string batch = (dir_ / "cases.jsonl").string();
+  std::ofstream(batch) << null_prior.dump() << "\n" << no_prior.dump() << "\n" << prior.dump();
+  const CommandRun run = Linetrack("localize --batch " + batch);
+  ASSERT_EQ(run.code, 0) << run.err;
+  std::istringstream out(run.out);
+  std::vector<nlohmann::json> results;
+  for (std::string line; std::getline(out, line);)
+    results.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(results.size(), 3u) << run.out;
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_TRUE(results[i]["global"].get<bool>()) << results[i];
+    ASSERT_TRUE(results[i]["found"].get<bool>()) << results[i];
+    ExpectPoseNear(results[i]["pose"], 1.0, 1.0, 45.0);
+  }
+  EXPECT_EQ(results[0]["id"], "null");
+  EXPECT_FALSE(results[2].contains("global")) << results[2];
+  ASSERT_TRUE(results[2]["found"].get<bool>()) << results[2];
+  ExpectPoseNear(results[2]["pose"], 1.0, 1.0, 45.0);
+}
+
+// An image localised with no prior goes through the same integrity gate as a local answer: the
+// right pose, its protection levels beyond the default alert limit (0.1 m), is withheld with
+// exit 1; within a wider alert limit it is the answer.
+TEST_F(HeadingViewsCli, LocalizeImageGlobalPassesTheIntegrityGate) {
+  const std::string image = Render(kRoom, kCamera, "1.0,1.0,45", 5.0);
+  const std::string args = "localize --global --image " + image + " --model " + kRoom +
+                           " --camera " + kCamera + " --height 1.3 --tilt 5 --json";
+  const CommandRun withheld = Linetrack(args);
+  ASSERT_EQ(withheld.code, 1) << withheld.out << withheld.err;
+  const nlohmann::json w = nlohmann::json::parse(withheld.out);
+  EXPECT_TRUE(w["global"].get<bool>());
+  EXPECT_FALSE(w["found"].get<bool>());
+  EXPECT_TRUE(w["pose"].is_null());
+  ASSERT_TRUE(w.contains("integrity")) << w;
+  EXPECT_NE(w["reason"].get<std::string>().find("alert limit"), std::string::npos) << w;
+  ExpectPoseNear(w["candidate"], 1.0, 1.0, 45.0);
+
+  const CommandRun accepted = Linetrack(args + " --alert-limit 0.5,5");
+  ASSERT_EQ(accepted.code, 0) << accepted.out << accepted.err;
+  const nlohmann::json a = nlohmann::json::parse(accepted.out);
+  EXPECT_TRUE(a["found"].get<bool>());
+  EXPECT_EQ(a["integrity"]["status"], "tracking") << a;
+  ExpectPoseNear(a["pose"], 1.0, 1.0, 45.0);
+}
+
+TEST_F(HeadingViewsCli, LocalizeGlobalWithAPriorIsBadInput) {
+  const std::string csv = (dir_ / "one.csv").string();
+  std::ofstream(csv) << "u1,v1,u2,v2\n100,100,300,120\n";
+  const std::string common = "localize --global --lines " + csv + " --model " + kRoom +
+                             " --camera " + kCamera + " --height 1.3 --tilt 5";
+  for (const std::string flag : {" --prior 1,1,0", " --delta-t 1", " --delta-phi 10"}) {
+    const CommandRun run = Linetrack(common + flag);
+    EXPECT_EQ(run.code, 2) << flag;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+    EXPECT_NE(run.err.find("--global"), std::string::npos) << run.err;
+  }
+  const CommandRun neither = Linetrack("localize --lines " + csv + " --model " + kRoom +
+                                       " --camera " + kCamera + " --height 1.3 --tilt 5");
+  EXPECT_EQ(neither.code, 2);
+  EXPECT_NE(neither.err.find("--prior"), std::string::npos) << neither.err;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -34,6 +35,11 @@ constexpr double kCsvTolPx = 1e-3;  // the CSV keeps three decimals
 // End to end from rendered images (generous: the matcher is not under test here).
 constexpr double kPositionTolM = 0.2;
 constexpr double kHeadingTolDeg = 3.0;
+// A single view's protection levels are 0.16-0.74 m for these four (the default 0.10 m alert
+// limit answers none of them): a limit a single-image answer meets.
+constexpr double kAlertLimitM = 1.0;
+const std::string kAlertLimit = "1,5";
+constexpr int kMinAnswered = 4;
 
 int Lines(const std::string& text) {
   int n = 0;
@@ -108,6 +114,7 @@ TEST_F(LinesCli, LocalizesRenderedViewsFromTheirImages) {
       {{11.5, 1.5, DegToRad(120.0), 1.35, DegToRad(8.0)}, 0.3, 0.5, 8.0},
       {{3.0, 7.0, DegToRad(-60.0), 1.5, DegToRad(0.0)}, -0.2, -0.6, -18.0},
   };
+  int answered = 0;
   for (const Case& c : cases) {
     SCOPED_TRACE("view at " + std::to_string(c.truth.x) + ", " + std::to_string(c.truth.y));
     const std::string image = RenderView(c.truth, "view.png");
@@ -117,19 +124,54 @@ TEST_F(LinesCli, LocalizesRenderedViewsFromTheirImages) {
          << " --overlay " << overlay << " --prior " << c.truth.x + c.dx << "," << c.truth.y + c.dy
          << "," << RadToDeg(c.truth.heading) + c.dh_deg
          << " --delta-t 0.75 --delta-phi 20 --height " << c.truth.height << " --tilt "
-         << RadToDeg(c.truth.tilt) << " --focal-error 0.005";
+         << RadToDeg(c.truth.tilt) << " --focal-error 0.005 --camera-sigma 0,0 --alert-limit "
+         << kAlertLimit;
     const CommandRun run = Linetrack(args.str());
-    ASSERT_EQ(run.code, 0) << run.out << run.err;
     const nlohmann::json result = nlohmann::json::parse(run.out);
-    ASSERT_TRUE(result["found"].get<bool>());
-    EXPECT_NEAR(result["pose"]["x"].get<double>(), c.truth.x, kPositionTolM);
-    EXPECT_NEAR(result["pose"]["y"].get<double>(), c.truth.y, kPositionTolM);
-    EXPECT_NEAR(RadToDeg(WrapAngle(DegToRad(result["pose"]["heading_deg"].get<double>()) -
-                                   c.truth.heading)),
+    // An answer, or (its protection level beyond the alert limit) the candidate withheld.
+    const bool found = result["found"].get<bool>();
+    EXPECT_EQ(run.code, found ? 0 : 1) << run.err;
+    answered += found;
+    const nlohmann::json& pose = found ? result["pose"] : result["candidate"];
+    ASSERT_TRUE(pose.is_object()) << run.out;
+    EXPECT_NEAR(pose["x"].get<double>(), c.truth.x, kPositionTolM);
+    EXPECT_NEAR(pose["y"].get<double>(), c.truth.y, kPositionTolM);
+    EXPECT_NEAR(RadToDeg(WrapAngle(DegToRad(pose["heading_deg"].get<double>()) - c.truth.heading)),
                 0.0, kHeadingTolDeg);
     EXPECT_GT(result["lines"].get<int>(), 5);
     EXPECT_TRUE(fs::is_regular_file(overlay));
+    // Issue 14: the answer comes with its covariance and protection levels; it is an answer
+    // only within the alert limit (the renderer's intrinsics are exact: --camera-sigma 0,0).
+    const nlohmann::json& integrity = result["integrity"];
+    std::cout << "view " << c.truth.x << ", " << c.truth.y << ": " << integrity["status"] << ", "
+              << integrity["reason"] << "\n";
+    EXPECT_EQ(integrity["covariance"].size(), 6u);
+    EXPECT_EQ(found, integrity["status"] == "tracking");
+    if (found) {
+      EXPECT_LE(integrity["protection_level_m"].get<double>(), kAlertLimitM);
+    }
   }
+  EXPECT_GE(answered, kMinAnswered);
+}
+
+// An answer whose protection levels exceed the alert limit is no answer: "found" false, the
+// candidate and the matcher's rivals listed, exit 1.
+TEST_F(LinesCli, AnAnswerBeyondTheAlertLimitIsNoAnswer) {
+  const RobotPose truth{2.0, 2.0, DegToRad(30.0), 1.3, DegToRad(5.0)};
+  const std::string image = RenderView(truth, "view.png");
+  std::ostringstream args;
+  args << "localize --json --model " << kModel << " --camera " << kCamera << " --image " << image
+       << " --prior 2.4,1.7,42 --delta-t 0.75 --delta-phi 20 --height 1.3 --tilt 5"
+       << " --focal-error 0.005 --alert-limit 0.0005,0.01";
+  const CommandRun run = Linetrack(args.str());
+  EXPECT_EQ(run.code, 1) << run.out << run.err;
+  const nlohmann::json result = nlohmann::json::parse(run.out);
+  EXPECT_FALSE(result["found"].get<bool>());
+  EXPECT_TRUE(result["answer"] == "none" || result["answer"] == "ambiguous") << result["answer"];
+  EXPECT_TRUE(result["pose"].is_null());
+  EXPECT_NEAR(result["candidate"]["x"].get<double>(), truth.x, kPositionTolM);
+  EXPECT_NE(result["reason"].get<std::string>().find("alert limit"), std::string::npos);
+  EXPECT_TRUE(result["rivals"].is_array());
 }
 
 TEST_F(LinesCli, UnreadableOrEmptyImagesExit2WithOneLineAndNoOutput) {

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 
 constexpr double kMaxFinalErrorPx = 2.0;
 constexpr double kMaxPositionErrorM = 0.08;  // tracked poses while the head slews
-constexpr int kCsvColumns = 27;
+constexpr int kCsvColumns = 33;
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 const std::string kModel = kSource + "/models/hall.cao";
@@ -86,8 +86,10 @@ class LiveCli : public test_support::CliTest {
 
 TEST_F(LiveCli, SimulatedRunWritesItsOutputsAndConverges) {
   std::string err;
-  ASSERT_EQ(Live(StillSim() + " --head-start-offset 10,5 --duration 2 --snapshot-every 30", &err),
-            0)
+  ASSERT_EQ(
+      Live(StillSim() + " --head-start-offset 10,5 --duration 2 --snapshot-every 30 --all-poses",
+           &err),
+      0)
       << err;
   const std::vector<std::string> rows = Lines(ReadAll(out_ / "frames.csv"));
   ASSERT_EQ(rows.size(), 61u);  // header + 2 s at 30 frames/s
@@ -97,21 +99,24 @@ TEST_F(LiveCli, SimulatedRunWritesItsOutputsAndConverges) {
     ASSERT_EQ(f.size(), static_cast<size_t>(kCsvColumns)) << rows[k];
     EXPECT_EQ(f[0], std::to_string(k - 1));
     EXPECT_EQ(f[2], "ok");
-    EXPECT_EQ(f[3], "tracking");
+    // The matcher's first pose is degraded until the next frames confirm it.
+    EXPECT_TRUE(f[3] == "tracking" || f[3] == "degraded") << rows[k];
+    EXPECT_TRUE(f[4] == "tracking" || f[4] == "relocalised") << rows[k];
   }
+  EXPECT_EQ(CsvFields(rows[1])[3], "degraded");
   const std::vector<std::string> first = CsvFields(rows[1]), last = CsvFields(rows.back());
-  EXPECT_GT(std::stod(first[14]), 150.0);  // 10 deg / 5 deg off at px = 1000
-  EXPECT_EQ(first[9], "velocity");
-  EXPECT_LT(std::stod(last[14]), kMaxFinalErrorPx);
-  EXPECT_EQ(last[16], "1");  // converged
+  EXPECT_GT(std::stod(first[15]), 150.0);  // 10 deg / 5 deg off at px = 1000
+  EXPECT_EQ(first[10], "velocity");
+  EXPECT_LT(std::stod(last[15]), kMaxFinalErrorPx);
+  EXPECT_EQ(last[17], "1");  // converged
 
   // The tracker's poses (the first from the matcher) against the simulator's truth.
   const std::vector<StampedPose> poses = ParseTum(ReadAll(out_ / "poses.txt"), "poses.txt");
   const std::vector<StampedPose> truth = ParseTum(ReadAll(out_ / "truth.txt"), "truth.txt");
   ASSERT_EQ(poses.size(), 60u);
   ASSERT_EQ(truth.size(), 60u);
-  EXPECT_EQ(first[4], "matcher");
-  EXPECT_EQ(last[4], "tracker");
+  EXPECT_EQ(first[5], "matcher");
+  EXPECT_EQ(last[5], "tracker");
   for (size_t k = 0; k < poses.size(); ++k) {
     EXPECT_LT(
         (poses[k].world_from_cam.translation() - truth[k].world_from_cam.translation()).norm(),
@@ -128,6 +133,12 @@ TEST_F(LiveCli, SimulatedRunWritesItsOutputsAndConverges) {
   EXPECT_LT(summary["final_error_px"].get<double>(), kMaxFinalErrorPx);
   EXPECT_GE(summary["first_convergence_s"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(out_ / "snapshots" / "frame_00000.png"));
+  // Issue 14: a covariance line per frame, and no pose `tracking` beyond its protection levels
+  // against the simulator's truth (the far target's view: most poses are `degraded`, their
+  // protection levels of 0.3-0.5 m beyond the 0.10 m alert limit).
+  EXPECT_EQ(Lines(ReadAll(out_ / "covariance.jsonl")).size(), 60u);
+  EXPECT_EQ(summary["integrity"]["ground_truth"]["integrity_failures"], 0);
+  EXPECT_EQ(summary["integrity"]["ground_truth"]["poses_compared"], 60);
   EXPECT_TRUE(fs::exists(out_ / "snapshots" / "frame_00030.png"));
   EXPECT_FALSE(fs::exists(out_ / "snapshots" / "frame_00015.png"));
 }
@@ -157,6 +168,22 @@ TEST_F(LiveCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
   for (const auto& [args, what] : cases) {
     std::string err;
     EXPECT_EQ(Live(args + common, &err), 2) << args;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;
+    EXPECT_NE(err.find(what), std::string::npos) << args << ": " << err;
+    EXPECT_FALSE(fs::exists(out_)) << args;
+  }
+  const std::string without_height =
+      " --model " + kModel + " --camera " + kCamera + " --out " + out_.string();
+  const std::vector<std::pair<std::string, std::string>> more = {
+      {"--source sim --head sim --prior 3,1.5,20 --height -1", "--height"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 0", "--height"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 1.3 --estimator truth --settings s.xml",
+       "--settings"},
+      {"--source sim --head sim --prior 3,1.5,20 --height 1.3 --camera-fps 30", "--camera-fps"},
+  };
+  for (const auto& [args, what] : more) {
+    std::string err;
+    EXPECT_EQ(Live(args + without_height, &err), 2) << args;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;
     EXPECT_NE(err.find(what), std::string::npos) << args << ": " << err;
     EXPECT_FALSE(fs::exists(out_)) << args;
@@ -199,8 +226,8 @@ TEST_F(LiveCli, RecordedFramesAndAPtuOverItsSerialLine) {
   for (size_t k = 1; k < rows.size(); ++k) {
     const std::vector<std::string> f = CsvFields(rows[k]);
     ASSERT_EQ(f.size(), static_cast<size_t>(kCsvColumns)) << rows[k];
-    with_pose += f[3] == "tracking" || f[3] == "relocalised";
-    velocity += f[9] == "velocity";
+    with_pose += f[4] == "tracking" || f[4] == "relocalised";  // the tracker's state
+    velocity += f[10] == "velocity";
   }
   // The tracker's own gates drop frames of this turning start (2 or 3 of 20): one is refused
   // by the refinement residual's jump gate, whose pose would be 6.6 cm off
@@ -308,6 +335,7 @@ TEST_F(LiveCli, SigintStopsTheHeadAndLeavesValidFiles) {
                                    "100000",
                                    "--snapshot-every",
                                    "0",
+                                   "--all-poses",
                                    "--out",
                                    out_.string()};
   std::vector<char*> argv;

@@ -1,9 +1,12 @@
 // `linetrack localize` end to end: a batch mixing good and malformed cases answers every case in
-// order (malformed ones with an `error`, the others localised), an unreadable batch exits 2 with
-// one line, and the single-case form prints the batch's JSON keys.
+// order (malformed ones with an `error`, the others localised) and echoes each id as given, an
+// unreadable batch exits 2 with one line, and the single-case form prints the batch's JSON keys,
+// takes replay's prior bounds by default, names the matched edges, reads a ROS camera_info as
+// its camera and refuses bad heights and flags that cannot apply.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -49,7 +52,7 @@ TEST_F(LocalizeCli, MalformedCasesGetAnErrorAndTheOthersAreAnswered) {
         << "\n"
         << variant("unknown-model", [](nlohmann::json& j) { j["model"] = "/nonexistent.cao"; })
         << "\n"
-        << variant("missing-prior", [](nlohmann::json& j) { j.erase("prior"); }) << "\n"
+        << variant("bad-prior", [](nlohmann::json& j) { j["prior"] = {1.0, 2.0}; }) << "\n"
         << variant("missing-tilt", [](nlohmann::json& j) { j.erase("tilt"); }) << "\n"
         << "\n"  // blank: skipped
         << "{\"id\": \"not-json\", \"lines\": [1, 2,\n"
@@ -72,7 +75,7 @@ TEST_F(LocalizeCli, MalformedCasesGetAnErrorAndTheOthersAreAnswered) {
       {"nan", "not a number"},
       {"zero-length", "zero-length"},
       {"unknown-model", "/nonexistent.cao"},
-      {"missing-prior", "prior"},
+      {"bad-prior", "prior"},
       {"missing-tilt", "tilt"},
       {"line-9", "not valid JSON"},
       {"line-10", "JSON object"},
@@ -144,6 +147,178 @@ TEST_F(LocalizeCli, SingleCasePrintsTheBatchKeysOrFailsCleanly) {
   EXPECT_EQ(failed.code, 2);
   EXPECT_NE(failed.err.find("bad.csv"), std::string::npos) << failed.err;
   EXPECT_EQ(std::count(failed.err.begin(), failed.err.end(), '\n'), 1) << failed.err;
+}
+
+// A synthetic QI3 case of the hall as a lines CSV, and the flags that state it (but the bounds,
+// which are QI3's: the defaults).
+struct SingleCase {
+  nlohmann::json json;
+  std::string synth, flags;
+};
+
+class LocalizeSingleCli : public LocalizeCli {
+ protected:
+  SingleCase MakeSingleCase() {
+    const std::filesystem::path& dir = dir_;
+    SingleCase sc;
+    sc.synth = (dir / "synth").string();
+    EXPECT_EQ(Linetrack("synth --model " + kSource + "/models/hall.cao --out " + sc.synth +
+                        " --count 1 --qi 3")
+                  .code,
+              0);
+    std::ifstream cases(sc.synth + "/cases.jsonl");
+    std::string row;
+    std::getline(cases, row);
+    sc.json = nlohmann::json::parse(row);
+    std::ofstream csv(dir / "lines.csv");
+    for (const auto& l : sc.json["lines"])
+      csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+    std::ostringstream flags;
+    flags << "--model " << kSource << "/models/hall.cao --lines " << (dir / "lines.csv").string()
+          << " --prior " << sc.json["prior"][0] << "," << sc.json["prior"][1] << ","
+          << sc.json["prior"][2] << " --height " << sc.json["height"] << " --tilt "
+          << sc.json["tilt"];
+    sc.flags = flags.str();
+    return sc;
+  }
+};
+
+// The result JSON without its time.
+nlohmann::json Untimed(const std::string& out) {
+  nlohmann::json j = nlohmann::json::parse(out);
+  j.erase("time_ms");
+  return j;
+}
+
+TEST_F(LocalizeSingleCli, BoundsDefaultToReplaysAndMatchesShowEdgeNames) {
+  const SingleCase sc = MakeSingleCase();
+  ASSERT_NEAR(sc.json["delta_t"].get<double>(), 0.75, 1e-12);  // QI3 = replay's defaults
+  ASSERT_NEAR(sc.json["delta_phi"].get<double>(), 20.0, 1e-9);
+  const std::string camera = " --camera " + sc.synth + "/camera.xml";
+  const CommandRun defaults = Linetrack("localize " + sc.flags + camera + " --json");
+  const CommandRun explicit_bounds =
+      Linetrack("localize " + sc.flags + camera + " --delta-t 0.75 --delta-phi 20 --json");
+  ASSERT_EQ(defaults.code, 0) << defaults.err;
+  ASSERT_EQ(explicit_bounds.code, 0) << explicit_bounds.err;
+  const nlohmann::json result = Untimed(defaults.out);
+  EXPECT_EQ(result, Untimed(explicit_bounds.out));
+  // Every match's edge has a name in the hall (its .cao names lines and faces).
+  ASSERT_EQ(result["edge_names"].size(), result["matches"].size());
+  for (const auto& name : result["edge_names"])
+    EXPECT_FALSE(name.get<std::string>().empty()) << result.dump();
+
+  const CommandRun text = Linetrack("localize " + sc.flags + camera);
+  ASSERT_EQ(text.code, 0) << text.err;
+  const std::string first = result["edge_names"][0].get<std::string>();
+  EXPECT_NE(text.out.find(" " + first + " <- line "), std::string::npos) << text.out;
+}
+
+TEST_F(LocalizeSingleCli, RosAndOpenCvYamlAreTheSameCameraAsTheXml) {
+  const SingleCase sc = MakeSingleCase();
+  // The paper's camera of synth's camera.xml as ROS's camera_calibration_parsers write it.
+  std::ofstream(dir_ / "camera_info.yaml")
+      << "image_width: 640\nimage_height: 480\ncamera_name: Camera\n"
+      << "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [1000, 0, 320, 0, 1000, 240, 0, 0, 1]\n"
+      << "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n"
+      << "  data: [0, 0, 0, 0, 0]\n";
+  // The same camera as OpenCV's FileStorage writes it (calibrate's opencv.yml).
+  std::ofstream(dir_ / "opencv.yml")
+      << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+      << "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+      << "   data: [ 1000., 0., 320., 0., 1000., 240., 0., 0., 1. ]\n"
+      << "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+      << "   data: [ 0., 0., 0., 0., 0. ]\n";
+  const CommandRun xml =
+      Linetrack("localize " + sc.flags + " --camera " + sc.synth + "/camera.xml --json");
+  const CommandRun ros = Linetrack("localize " + sc.flags + " --camera " +
+                                   (dir_ / "camera_info.yaml").string() + " --json");
+  const CommandRun opencv =
+      Linetrack("localize " + sc.flags + " --camera " + (dir_ / "opencv.yml").string() + " --json");
+  ASSERT_EQ(xml.code, 0) << xml.err;
+  ASSERT_EQ(ros.code, 0) << ros.err;
+  ASSERT_EQ(opencv.code, 0) << opencv.err;
+  EXPECT_EQ(Untimed(xml.out), Untimed(ros.out));
+  EXPECT_EQ(Untimed(xml.out), Untimed(opencv.out));
+}
+
+TEST_F(LocalizeSingleCli, ANonPositiveHeightIsBadInput) {
+  const SingleCase sc = MakeSingleCase();
+  std::string flags = sc.flags;
+  const size_t at = flags.find("--height ");
+  flags.erase(at, flags.find(' ', at + 9) - at);  // drop the case's own height
+  for (const std::string height : {"-1", "0", "nan"}) {
+    const CommandRun run =
+        Linetrack("localize " + flags + " --camera " + sc.synth + "/camera.xml --height " + height);
+    EXPECT_EQ(run.code, 2) << height << ": " << run.err;
+    EXPECT_NE(run.err.find("--height"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+  }
+}
+
+TEST_F(LocalizeSingleCli, BatchIdsComeBackAsGiven) {
+  const SingleCase sc = MakeSingleCase();
+  nlohmann::json c = sc.json;
+  c["model"] = kSource + "/models/hall.cao";
+  c["camera"] = sc.synth + "/camera.xml";
+  std::ofstream batch(dir_ / "ids.jsonl");
+  for (const nlohmann::json& id :
+       {nlohmann::json(7), nlohmann::json("seven"), nlohmann::json(2.5)}) {
+    c["id"] = id;
+    batch << c.dump() << "\n";
+  }
+  c["id"] = 9;
+  c["height"] = -1.0;  // an error result keeps its id too
+  batch << c.dump() << "\n";
+  batch.close();
+  const CommandRun run = Linetrack("localize --batch " + (dir_ / "ids.jsonl").string());
+  ASSERT_EQ(run.code, 0) << run.err;
+  std::istringstream rows(run.out);
+  std::vector<nlohmann::json> results;
+  for (std::string row; std::getline(rows, row);)
+    results.push_back(nlohmann::json::parse(row));
+  ASSERT_EQ(results.size(), 4u) << run.out;
+  EXPECT_TRUE(results[0]["id"].is_number_integer());
+  EXPECT_EQ(results[0]["id"], 7);
+  EXPECT_EQ(results[1]["id"], "seven");
+  EXPECT_EQ(results[2]["id"], 2.5);
+  EXPECT_EQ(results[3]["id"], 9);
+  EXPECT_NE(results[3]["error"].get<std::string>().find("\"height\""), std::string::npos)
+      << results[3].dump();
+}
+
+TEST_F(LocalizeSingleCli, FlagsThatCannotApplyAreRefused) {
+  const SingleCase sc = MakeSingleCase();
+  const std::string camera = " --camera " + sc.synth + "/camera.xml";
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"localize --batch " + (dir_ / "b.jsonl").string() + " --tilt 5", "--tilt"},
+      {"localize " + sc.flags + camera + " --detector lsd", "--detector"},
+      {"localize " + sc.flags + camera + " --overlay " + (dir_ / "o.png").string(), "--overlay"},
+      {"localize --model m.cao --camera c.xml --lines l.csv --prior 1,2,3 --height 1", "--tilt"},
+  };
+  for (const auto& [args, flag] : refused) {
+    const CommandRun run = Linetrack(args);
+    EXPECT_EQ(run.code, 2) << args;
+    EXPECT_NE(run.err.find(flag), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("is required is required"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
+}
+
+TEST_F(LocalizeSingleCli, GlobalFlagsWorkAfterTheSubcommand) {
+  const SingleCase sc = MakeSingleCase();
+  const std::string args = sc.flags + " --camera " + sc.synth + "/camera.xml";
+  const CommandRun loud = Linetrack("localize " + args);
+  const CommandRun before = Linetrack("-q localize " + args);
+  const CommandRun after = Linetrack("localize " + args + " -q");
+  ASSERT_EQ(loud.code, 0) << loud.err;
+  EXPECT_EQ(before.code, 0) << before.err;
+  EXPECT_EQ(after.code, 0) << after.err;
+  EXPECT_TRUE(after.err.empty()) << after.err;
+  EXPECT_EQ(after.err, before.err);
+  const CommandRun unknown = Linetrack("localize " + args + " --no-such-flag");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("--no-such-flag"), std::string::npos) << unknown.err;
 }
 
 }  // namespace

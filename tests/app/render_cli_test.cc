@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "models/render/frame_truth.h"
 #include "models/render/scene_renderer.h"
 #include "models/trajectory_io.h"
 #include "tests/support/cli_test.h"
@@ -28,6 +29,16 @@ class RenderCli : public test_support::CliTest {
   // Runs `linetrack render` on the hall with the paper's camera and ARGS.
   test_support::CommandRun Render(const std::string& args) const {
     return Linetrack("render --model " + kModel + " --camera " + kCamera + " " + args);
+  }
+
+  // Each case (ARGS, what the message must say) exits 2 with one line on stderr.
+  void ExpectBadInput(const std::vector<std::pair<std::string, std::string>>& cases) const {
+    for (const auto& [args, what] : cases) {
+      const test_support::CommandRun run = Render(args);
+      EXPECT_EQ(run.code, 2) << args;
+      EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
+      EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    }
   }
 };
 
@@ -84,6 +95,62 @@ TEST_F(RenderCli, HallLoopWithPanTilt) {
   EXPECT_EQ(ReadPriors((out / "priors.csv").string()).size(), 2u);
 }
 
+TEST_F(RenderCli, WaypointPathWithEffectsWritesTheTruth) {
+  const std::string path = (dir_ / "path.csv").string();
+  std::ofstream(path) << "# x,y[,heading_deg]\n1,1\n5,1\n5,3,90\n";
+  const fs::path out = dir_ / "drive";
+  const test_support::CommandRun run = Render(
+      "--path " + path + " --nav " + kNav +
+      " --frames 12 --speed 0.5 --pan-amplitude 35 --pan-rate 30 --people 1 --blackouts 1 "
+      "--blackout-duration 0.2 --exposure-changes 1 --shutter 0.02 --odometry-drift 2.5 --out " +
+      out.string());
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("wrote 12 frames"), std::string::npos) << run.out;
+  const std::vector<FrameTruth> truth = ReadFrameTruth((out / "frame_truth.csv").string());
+  ASSERT_EQ(truth.size(), 12u);
+  EXPECT_EQ(
+      std::count_if(truth.begin(), truth.end(), [](const FrameTruth& t) { return t.covered; }), 2);
+  EXPECT_NEAR(truth[5].pan_deg, 15.0, 1e-3);  // 0.5 s at 30 deg/s
+  const std::string sequence = test_support::ReadAll(out / "sequence.json");
+  EXPECT_NE(sequence.find("\"blackouts\""), std::string::npos);
+  EXPECT_NE(sequence.find("\"asked_percent\": 2.5"), std::string::npos) << sequence;
+  EXPECT_EQ(ReadTum((out / "groundtruth.txt").string()).size(), 12u);
+  EXPECT_NEAR(ReadTum((out / "groundtruth.txt").string())[0].world_from_cam.translation().x(), 1.0,
+              1e-9);
+}
+
+TEST_F(RenderCli, FlagsThatCannotApplyAreRefused) {
+  const std::string png = (dir_ / "x.png").string();
+  const std::string seq = (dir_ / "seq").string();
+  const std::string tum = (dir_ / "in.txt").string();
+  std::ofstream(tum) << FormatTum({{0.0, CamFromWorld({3.0, 2.0, 0.0, 1.3, 0.0}).inverse()}});
+  const std::string path = (dir_ / "path.csv").string();
+  std::ofstream(path) << "1,1\n5,1\n";
+  const std::string bad = (dir_ / "bad.csv").string();
+  std::ofstream(bad) << "1,1\n5;1\n";
+  const std::string pillar = (dir_ / "pillar.csv").string();
+  std::ofstream(pillar) << "1,4.5\n8,4.5\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--trajectory " + tum + " --pan-amplitude 20 --speed 2 --out " + seq,
+       "--speed does not apply to --trajectory"},
+      {"--trajectory " + tum + " --height 1.2 --out " + seq, "--height does not apply"},
+      {"--pose 1,2,3 --frames 3 --out " + png, "--frames does not apply to one view"},
+      {"--pose 1,2,3 --people 1 --out " + png, "--people does not apply"},
+      {"--path hall-loop --corner-radius 1 --out " + seq,
+       "--corner-radius does not apply to --path hall-loop"},
+      {"--path " + path + " --wall-distance 1 --out " + seq, "--wall-distance does not apply"},
+      {"--path hall-loop --pan-rate 30 --pan-period 4 --out " + seq, "not both"},
+      {"--path " + bad + " --nav " + kNav + " --out " + seq, "bad.csv:2:"},
+      {"--path " + path + " --nav " + kNav + " --frames 1000 --out " + seq, "frames at most"},
+      {"--path " + pillar + " --nav " + kNav + " --out " + seq, "leaves the navigable area"},
+      {"--path " + path + " --nav " + kNav + " --odometry-drift -1 --out " + seq,
+       "--odometry-drift"},
+  };
+  ExpectBadInput(cases);
+  EXPECT_FALSE(fs::exists(png));
+  EXPECT_FALSE(fs::exists(seq));
+}
+
 TEST_F(RenderCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
   const std::string png = (dir_ / "x.png").string();
   const std::string seq = (dir_ / "seq").string();
@@ -95,18 +162,13 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {"--pose 1,2,3 --out " + (dir_ / "x.jpg").string(), ".png"},
       {"--pose 1,2,3 --noise -1 --out " + png, "noise"},
       {"--pose 1,2,3 --tilt 95 --out " + png, "--tilt"},
-      {"--path circle --out " + seq, "unknown path"},
+      {"--path circle --out " + seq, "neither hall-loop nor a waypoint file"},
       {"--path hall-loop --nav " + kNav + " --speed 0 --out " + seq, "speed"},
       {"--path hall-loop --nav /nonexistent.json --out " + seq, "/nonexistent.json"},
       {"--trajectory " + bad_tum + " --out " + seq, "bad.txt:2:"},
       {"--trajectory /nonexistent.txt --out " + seq, "/nonexistent.txt"},
   };
-  for (const auto& [args, what] : cases) {
-    const test_support::CommandRun run = Render(args);
-    EXPECT_EQ(run.code, 2) << args;
-    EXPECT_NE(run.err.find(what), std::string::npos) << args << " -> " << run.err;
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
-  }
+  ExpectBadInput(cases);
   EXPECT_FALSE(fs::exists(png));
   EXPECT_FALSE(fs::exists(seq));
 }

@@ -1,9 +1,10 @@
 // `linetrack replay` end to end: Castle-simu started from its first pose file with the ground
 // truth as a pattern of pose files, a rendered hall sequence started by the matcher from its prior
 // file, a source that breaks in the middle (files valid up to the last frame, summary saying so),
-// and bad input (exit 2, one line, no output folder).
+// and bad input, flags that cannot apply among it (exit 2, one line, no output folder).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -21,8 +22,13 @@ using test_support::ReadAll;
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 constexpr double kCastleMaxAteM = 0.005;
+// The castle is a tabletop model, exact in the simulation: its edges are where the model says
+// to half a millimetre (the default model-error allowance, 3 mm, is a building's).
+const std::string kCastleModelSigma = "0.0005";
+constexpr int kCastleMinTracking = 36;  // of 40
 constexpr double kHallMaxAteM = 0.02;
 constexpr int kMaxInitialisingFrames = 3;
+constexpr double kEpochS = 1.7e9;  // a time base in epoch seconds
 
 int CountLines(const fs::path& path) {
   std::ifstream in(path);
@@ -31,6 +37,25 @@ int CountLines(const fs::path& path) {
   while (std::getline(in, line))
     ++n;
   return n;
+}
+
+// Copies a prior file (CSV) or TUM file with `offset` seconds added to its first field.
+void ShiftTimes(const fs::path& from, double offset, char separator, const fs::path& to) {
+  std::ifstream in(from);
+  std::ofstream out(to);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t end = line.find(separator);
+    if (line.empty() || line[0] == '#' || end == std::string::npos ||
+        line.find_first_not_of("0123456789.-") < end) {
+      out << line << "\n";  // header or comment
+      continue;
+    }
+    std::ostringstream shifted;
+    shifted.precision(15);
+    shifted << std::stod(line.substr(0, end)) + offset << line.substr(end) << "\n";
+    out << shifted.str();
+  }
 }
 
 std::string VispImages() {
@@ -49,7 +74,8 @@ class ReplayCli : public test_support::CliTest {
     return "replay --input '" + input + "' --model " + kSource +
            "/tests/data/visp/castle_simu_scene.cao --camera " + castle_ +
            "/Config/chateau.xml --settings " + castle_ + "/Config/chateau.xml --init-pose " +
-           castle_ + "/CameraPose/Camera_001.txt --out " + out.string();
+           castle_ + "/CameraPose/Camera_001.txt --model-sigma " + kCastleModelSigma + " --out " +
+           out.string();
   }
 
   std::string castle_;
@@ -60,7 +86,6 @@ TEST_F(ReplayCli, CastleSimuFromItsPoseFileWithGroundTruth) {
   const CommandRun run = Linetrack(CastleArgs(castle_ + "/Images/Image_%04d.pgm", out) +
                                    " --ground-truth '" + castle_ + "/CameraPose/Camera_%03d.txt'");
   ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_EQ(CountLines(out / "poses.txt"), 1 + 40);  // header + every frame
   EXPECT_EQ(CountLines(out / "frames.csv"), 1 + 40);
   const nlohmann::json summary = nlohmann::json::parse(ReadAll(out / "summary.json"));
   EXPECT_TRUE(summary["complete"].get<bool>());
@@ -72,6 +97,12 @@ TEST_F(ReplayCli, CastleSimuFromItsPoseFileWithGroundTruth) {
   const std::string overlay = summary["overlay"]["path"].get<std::string>();
   ASSERT_TRUE(fs::exists(overlay)) << overlay;
   EXPECT_GT(fs::file_size(overlay), 1000u);
+  // Issue 14: poses.txt holds the poses `tracking` (nearly all), none beyond its protection level.
+  const nlohmann::json& integrity = summary["integrity"];
+  const int tracking = integrity["status_counts"]["tracking"].get<int>();
+  EXPECT_GE(tracking, kCastleMinTracking);
+  EXPECT_EQ(CountLines(out / "poses.txt"), 1 + tracking);
+  EXPECT_EQ(integrity["ground_truth"]["integrity_failures"].get<int>(), 0);
   // frames.csv: the file numbers of the sequence (from 1), the status of each frame.
   std::ifstream csv(out / "frames.csv");
   std::string header, first;
@@ -106,6 +137,45 @@ TEST_F(ReplayCli, RenderedHallStartedByTheMatcherFromItsPriorFile) {
   EXPECT_LT(summary["ground_truth"]["ate_rmse_m"].get<double>(), kHallMaxAteM);
   EXPECT_TRUE(fs::exists(out / "overlay" / "frame_00000.png"));
   EXPECT_TRUE(fs::exists(out / "overlay" / "frame_00019.png"));
+  // Issue 14: the integrity of every pose. No pose `tracking` is beyond its protection levels;
+  // poses.txt holds the `tracking` poses; covariance.jsonl a line per frame.
+  const nlohmann::json& integrity = summary["integrity"];
+  EXPECT_EQ(integrity["ground_truth"]["integrity_failures"].get<int>(), 0);
+  EXPECT_GT(integrity["status_counts"]["tracking"].get<int>(), 0);
+  EXPECT_EQ(CountLines(out / "poses.txt"), 1 + integrity["status_counts"]["tracking"].get<int>());
+  EXPECT_EQ(CountLines(out / "covariance.jsonl"), 20);
+  EXPECT_GT(integrity["sigma_x_m"]["p50"].get<double>(), 0.0);
+  std::ifstream csv(out / "frames.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",state,sigma_x_m,sigma_y_m,sigma_heading_deg,protection_level_m,"
+                        "protection_level_deg,"),
+            std::string::npos)
+      << header;
+
+  // Time bases: the prior file and the ground truth stamped in epoch seconds against frames
+  // timed from 0 are refused in one line (exit 2, no output); --align-times reads them.
+  const fs::path epoch_priors = dir_ / "epoch_priors.csv", epoch_truth = dir_ / "epoch_truth.txt";
+  ShiftTimes(seq / "priors.csv", kEpochS, ',', epoch_priors);
+  ShiftTimes(seq / "groundtruth.txt", kEpochS, ' ', epoch_truth);
+  const std::string base = "replay --input '" + (seq / "frame_%05d.png").string() + "' --model " +
+                           kSource + "/models/hall.cao --camera " + (seq / "camera.xml").string() +
+                           " --no-overlay --frames 4 ";
+  const fs::path never = dir_ / "never";
+  for (const std::string& args :
+       {base + "--prior-file " + epoch_priors.string() + " --out " + never.string(),
+        base + "--prior-file " + (seq / "priors.csv").string() + " --ground-truth " +
+            epoch_truth.string() + " --out " + never.string()}) {
+    const CommandRun bad = Linetrack(args);
+    EXPECT_EQ(bad.code, 2) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+    EXPECT_NE(bad.err.find("do not overlap"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(never));
+  }
+  const fs::path aligned = dir_ / "aligned";
+  const CommandRun run_aligned = Linetrack(base + "--prior-file " + epoch_priors.string() +
+                                           " --align-times --out " + aligned.string());
+  EXPECT_EQ(run_aligned.code, 0) << run_aligned.err;
 }
 
 TEST_F(ReplayCli, ABrokenSourceLeavesValidFilesAndSaysSo) {
@@ -153,6 +223,36 @@ TEST_F(ReplayCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
     EXPECT_FALSE(fs::exists(out)) << args;
   }
+}
+
+TEST_F(ReplayCli, HeightAndInapplicableFlagsAreBadInput) {
+  const fs::path out = dir_ / "never";
+  const std::string castle = CastleArgs(castle_ + "/Images/Image_%04d.pgm", out);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {castle + " --prior 1,2,30 --height -1 --tilt 0", "--height"},
+      {castle + " --prior 1,2,30 --height 0 --tilt 0", "--height"},
+      {castle + " --prior 1,2,30 --height nan --tilt 0", "--height"},
+      {castle + " --overlay-png --no-overlay", "--overlay-png"},
+      {castle + " --delta-t 1", "--delta-t"},      // no robot: no matcher to bound
+      {castle + " --detector lsd", "--detector"},  // nor to extract lines for
+      {castle + " --prior-file p.csv --tilt 3", "--tilt"},
+  };
+  for (const auto& [args, flag] : bad) {
+    const CommandRun run = Linetrack(args);
+    EXPECT_EQ(run.code, 2) << args << "\n" << run.err;
+    EXPECT_NE(run.err.find(flag), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+}
+
+TEST_F(ReplayCli, QuietAfterTheSubcommand) {
+  const fs::path out = dir_ / "quiet";
+  const CommandRun run = Linetrack(CastleArgs(castle_ + "/Images/Image_%04d.pgm", out) +
+                                   " --frames 3 --no-overlay -q");
+  EXPECT_EQ(run.code, 0) << run.err;
+  EXPECT_TRUE(run.err.empty()) << run.err;
+  EXPECT_NE(run.out.find("replayed 3 frames"), std::string::npos) << run.out;
 }
 
 TEST_F(ReplayCli, HelpNamesTheOptions) {

@@ -60,7 +60,7 @@ TEST_F(SynthCli, CasesParseAsABatchAndAgreeWithTheTruth) {
     const app::BatchCase c = app::ParseBatchCase(cases[i], out.string());
     char id[32];
     std::snprintf(id, sizeof(id), "hall-qi2-%05zu", i);
-    EXPECT_EQ(c.id, id);
+    EXPECT_EQ(c.id, std::string(id));
     EXPECT_TRUE(fs::equivalent(c.model_path, kModel)) << c.model_path;
     EXPECT_TRUE(fs::equivalent(c.camera_path, out / "camera.xml")) << c.camera_path;
     EXPECT_NEAR(c.problem.delta_t, 0.5, 1e-12);

@@ -18,6 +18,17 @@ class ConstraintsTest : public ::testing::Test {
   testing::HallFixture hall_;
 };
 
+// The prior disk (centre, radius delta_t) and headings heading +- delta_phi at `height`.
+PriorRegion Prior(const Eigen::Vector2d& centre, double delta_t, double heading, double delta_phi,
+                  double height) {
+  PriorRegion prior;
+  prior.centre = centre;
+  prior.radius = delta_t;
+  prior.heading = {heading - delta_phi, heading + delta_phi};
+  prior.height = height;
+  return prior;
+}
+
 std::vector<ObservedLine> Prepare(const testing::ExactView& view, const CameraIntrinsics& cam) {
   std::vector<Segment2> segments;
   for (const ProjectedEdge& p : view.pieces)
@@ -66,12 +77,11 @@ TEST_F(ConstraintsTest, UnaryAndBinaryAcceptTheTruthAtAnyPriorInsideTheBounds) {
     while (offset.norm() > 1.0);
     const Eigen::Vector2d centre = Eigen::Vector2d(view.pose.x, view.pose.y) + delta_t * offset;
     const double heading = view.pose.heading + delta_phi * unit(rng);
-    const HeadingInterval prior{heading - delta_phi, heading + delta_phi};
+    const PriorRegion prior = Prior(centre, delta_t, heading, delta_phi, view.pose.height);
     for (size_t i = 0; i < lines.size(); ++i) {
       const MatchEdge edge = PrepareEdges(hall_.model(), {view.pieces[i].edge_id}).front();
       if (edge.vertical) {
-        EXPECT_TRUE(UnaryVertical(lines[i], edge, view.pose.height, prior, centre, delta_t, Gate())
-                        .has_value());
+        EXPECT_TRUE(UnaryVertical(lines[i], edge, prior, Gate()).has_value());
         for (size_t j = 0; j < lines.size(); ++j) {
           const MatchEdge other = PrepareEdges(hall_.model(), {view.pieces[j].edge_id}).front();
           if (j == i || !other.vertical || other.edge_id == edge.edge_id) continue;
@@ -80,9 +90,7 @@ TEST_F(ConstraintsTest, UnaryAndBinaryAcceptTheTruthAtAnyPriorInsideTheBounds) {
                                      kSigmas));
         }
       } else {
-        EXPECT_FALSE(
-            UnaryNonVertical(lines[i], edge, view.pose.height, prior, centre, delta_t, Gate())
-                .empty())
+        EXPECT_FALSE(UnaryNonVertical(lines[i], edge, prior, Gate()).empty())
             << "edge " << edge.edge_id << " view " << v;
       }
     }
@@ -119,17 +127,14 @@ TEST_F(ConstraintsTest, NoisyTruthPassesAndFalsePairingsAreCut) {
     while (offset.norm() > 1.0);
     const Eigen::Vector2d centre = Eigen::Vector2d(view.pose.x, view.pose.y) + delta_t * offset;
     const double heading = view.pose.heading + delta_phi * unit(rng);
-    const HeadingInterval prior{heading - delta_phi, heading + delta_phi};
+    const PriorRegion prior = Prior(centre, delta_t, heading, delta_phi, view.pose.height);
     for (size_t i = 0; i < lines.size(); ++i) {
       for (size_t j = 0; j < view.pieces.size(); ++j) {
         const MatchEdge edge = PrepareEdges(hall_.model(), {view.pieces[j].edge_id}).front();
-        const bool pass = edge.vertical ? lines[i].maybe_vertical &&
-                                              UnaryVertical(lines[i], edge, view.pose.height, prior,
-                                                            centre, delta_t, Gate())
-                                                  .has_value()
-                                        : !UnaryNonVertical(lines[i], edge, view.pose.height, prior,
-                                                            centre, delta_t, Gate())
-                                               .empty();
+        const bool pass = edge.vertical
+                              ? lines[i].maybe_vertical &&
+                                    UnaryVertical(lines[i], edge, prior, Gate()).has_value()
+                              : !UnaryNonVertical(lines[i], edge, prior, Gate()).empty();
         const bool truth = view.pieces[i].edge_id == edge.edge_id;
         (truth ? true_pass : false_pass) += pass ? 1 : 0;
         (truth ? true_total : false_total) += 1;

@@ -1,11 +1,11 @@
 // The localizer end to end on synthetic scenes of the hall (the paper's section 4.1, QI2 prior):
 // most scenes answered with correct correspondences, none answered wrong, the same result twice,
 // the search budget respected with 200 clutter lines, the truth's diagnosis consistent, and bad
-// problems rejected; the fourth and fifth rounds' wrong poses (seeds 6 and 5, QI2/QI3 priors) not
-// answered wrong; the seventh round's answer covariance without an unreported high-leverage pair
-// (seed 2 QI1); the tree's completed-pass bound when its budget runs out (eighth round); the root
-// branches an exhausted search did not reach and the covariance averaged over what the unreported
-// pairs are (ninth round).
+// problems rejected. Then scenes that exercise one rule each: an unobservable pose or one held at
+// the prior's border as a rival, a leaf giving a line to another edge verified, the answer's
+// covariance without an unreported high-leverage pair and averaged over what the unreported pairs
+// are, the tree's completed-pass bound when its budget runs out, and the root branches an
+// exhausted search did not reach.
 #include "matching/localizer.h"
 
 #include <gtest/gtest.h>
@@ -205,11 +205,10 @@ TEST_F(LocalizerTest, MalformedProblemsAreRejected) {
   expect_error(p, "prior x");
 }
 
-// The fourth round's wrong poses (docs/matching-rounds.md, "Fourth round"): answered about
-// 1 m and 6 degrees from the truth before; now the truth's interpretation rivals them.
-// Scene 53: the truth's pairs give a pose whose position sigma (0.54 m) exceeds the 0.5 m limit;
-// it explains the lines with 56.7 nats, the accepted pose (a true line on a wrong edge) 17.7.
-// An unobservable pose is still a rival explanation.
+// Seed 6 QI3 scene 53: the truth's pairs give a pose whose position sigma exceeds the 0.5 m
+// limit but which explains the lines far better than the best plausible pose (a true line on a
+// wrong edge, about 1 m and 6 degrees off). An unobservable pose is still a rival explanation: no
+// answer rather than the wrong one.
 TEST_F(LocalizerTest, UnobservablePoseThatExplainsMoreIsARival) {
   SyntheticScene scene;
   const LocalizationResult r = LocalizeSeed6Qi3NotWrong(53, &scene);
@@ -217,9 +216,9 @@ TEST_F(LocalizerTest, UnobservablePoseThatExplainsMoreIsARival) {
   EXPECT_NE(r.reason.find("unobservable pose"), std::string::npos) << r.reason;
 }
 
-// Scene 409: the truth's leaf (7 true pairs) was skipped because its feasible region held a
-// verified pose (47.4 nats) giving two of its lines to other edges; a leaf is only skipped as
-// "verified again" when it gives no line to another edge than that pose.
+// Seed 6 QI3 scene 409: the truth's leaf (7 true pairs) has a feasible region that holds a
+// verified pose giving two of its lines to other edges. A leaf is only skipped as "verified
+// again" when it gives no line to another edge than that pose, so the truth is verified.
 TEST_F(LocalizerTest, LeafAssigningLinesOtherwiseIsVerified) {
   SyntheticScene scene;
   const LocalizationResult r = LocalizeSeed6Qi3NotWrong(409, &scene);
@@ -237,11 +236,10 @@ TEST_F(LocalizerTest, LeafAssigningLinesOtherwiseIsVerified) {
   EXPECT_TRUE(truth_is_finalist);
 }
 
-// The fifth round (docs/matching-rounds.md): seed 5 scene 409 was answered 1.05 m and 6.7
-// degrees off at QI2 and QI3 (4 edges, 21.3 nats) because the truth's pairs, refined without the
-// prior, slid along their weakly observed direction 1.5 m out of it. Refined within the prior
-// (PoseBounds) they stop at its border, a pose held there (and at QI3 unobservable) that rivals
-// the wrong pose: no answer.
+// Seed 5 scene 409 at QI2 and QI3: the truth's pairs, refined without the prior, would slide
+// along their weakly observed direction far out of it, leaving a wrong pose (4 edges) unrivalled.
+// Refined within the prior (PoseBounds) they stop at its border, a pose held there (and at QI3
+// unobservable) that rivals the wrong pose: no answer.
 TEST_F(LocalizerTest, PoseHeldInsideThePriorRivalsAsUnobservable) {
   for (const auto& [delta_t, delta_phi_deg] : {std::pair{0.5, 15.0}, std::pair{0.75, 20.0}}) {
     SyntheticScene scene;
@@ -254,11 +252,10 @@ TEST_F(LocalizerTest, PoseHeldInsideThePriorRivalsAsUnobservable) {
   }
 }
 
-// Seed 2 QI1 scene 107 (seventh round): 7 true pairs leave the pose loose along a valley
-// (position sigma 0.22 m, heading 1.3 deg); guided matching added a clutter line (line 9) to edge
-// 57 with leverage 0.999, unreported, which alone fixed the heading to 0.22 deg sigma. The
-// answer, 0.64 m and 3.5 deg from the truth, claimed that precision: the truth's squared
-// Mahalanobis distance was 12 715. Its covariance now leans only on pairs it vouches for.
+// Seed 2 QI1 scene 107: 7 true pairs leave the pose loose along a valley; guided matching adds a
+// clutter line (line 9) to edge 57 with leverage near 1, unreported, which alone would fix the
+// heading far more precisely than the true pairs do. The answer's covariance leans only on the
+// reported pairs and the unreported ones of low leverage, so it holds the truth.
 TEST_F(LocalizerTest, CovarianceDoesNotLeanOnAnUnreportedHighLeveragePair) {
   SyntheticScene scene;
   const LocalizationResult r = LocalizeBenchmarkScene(2, 0.30, 10.0, 107, &scene);
@@ -276,11 +273,11 @@ TEST_F(LocalizerTest, CovarianceDoesNotLeanOnAnUnreportedHighLeveragePair) {
   EXPECT_GT(RadToDeg(r.heading_sigma_rad), 1.0);
 }
 
-// Seed 1 QI1 scene 77 (ninth round): guided matching gave a clutter line to vertical edge 50,
-// unreported, with leverage 0.61 (below max_unreported_leverage, so the vouched covariance keeps
-// it). The answer is 0.52 m from the truth and, leaning on that pair, put the truth at squared
-// Mahalanobis 40. Averaged over "the pair is clutter" (its posterior at the pose of the others),
-// the covariance holds the truth; the pose and the reported pairs are the same either way.
+// Seed 1 QI1 scene 77: guided matching gives a clutter line to vertical edge 50, unreported, with
+// leverage below max_unreported_leverage (so LowLeverageRefinement keeps it); the answer is about
+// half a metre from the truth. Leaning on that pair the covariance excludes the truth; averaged
+// over "the pair is clutter" (its posterior at the pose of the others) it holds the truth. The
+// pose and the reported pairs are the same either way.
 TEST_F(LocalizerTest, CovarianceAveragesOverWhatTheUnreportedPairsAre) {
   constexpr double kRegionChi2 = 16.27;  // 99.9 % of chi2(3)
   SyntheticScene scene;
@@ -310,17 +307,16 @@ TEST_F(LocalizerTest, CovarianceAveragesOverWhatTheUnreportedPairsAre) {
 // gives line 4 to edge 38. Pairs that fit the pose, or lines the pose does not explain, are no
 // contradiction.
 TEST(AssignsLineOtherwiseTest, OnlyALineOnAnotherEdgeContradicts) {
-  const std::vector<std::pair<int, int>> fitting = {{16, 9}, {18, 6}, {19, 4}, {38, 5}};
-  EXPECT_TRUE(AssignsLineOtherwise({{16, 9}, {38, 4}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {19, 4}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {35, 7}}, fitting));
-  EXPECT_FALSE(AssignsLineOtherwise({}, fitting));
+  const std::vector<std::pair<int, int>> consensus = {{16, 9}, {18, 6}, {19, 4}, {38, 5}};
+  EXPECT_TRUE(AssignsLineOtherwise({{16, 9}, {38, 4}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {19, 4}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({{16, 9}, {35, 7}}, consensus));
+  EXPECT_FALSE(AssignsLineOtherwise({}, consensus));
 }
 
-// The tree's completed_bound (docs/matching-rounds.md, eighth round): when the budget stops the
-// search, every leaf whose bound reaches the last completed pass's bound was visited. Checked
-// against the complete search (unit caps: a leaf's bound is its number of lines) on seed 1 QI1
-// scene 0.
+// The tree's completed_bound: when the budget stops the search, every leaf whose bound reaches
+// the last completed pass's bound was visited. Checked against the complete search (unit caps: a
+// leaf's bound is its number of lines) on seed 1 QI1 scene 0.
 TEST_F(LocalizerTest, LeavesAboveTheCompletedPassBoundAreVisitedWhenTheBudgetRunsOut) {
   const auto [edges, lines, prior] = BenchmarkTreeInput(1, 0.30, 10.0, 0);
   auto keys = [](const std::vector<Hypothesis>& leaves) {
@@ -362,7 +358,7 @@ TEST_F(LocalizerTest, LeavesAboveTheCompletedPassBoundAreVisitedWhenTheBudgetRun
   EXPECT_GT(completed_passes_seen, 0);
 }
 
-// Ninth round: when the budget stops the search in the root's first branch, the root's other
+// When the budget stops the search in the root's first branch, the root's other
 // branches are reported, and searching them visits leaves of the complete search that give the
 // root's line one of those edges (or leave it out, for the clutter branch), none already visited.
 TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
@@ -382,7 +378,7 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
     std::set<std::vector<std::pair<int, int>>> first;
     InterpretationTreeStats stats;
     SearchInterpretationTree(
-        edges, lines, prior, options, caps,
+        {&edges, &lines, &prior, &caps}, options,
         [&](const Hypothesis& h) {
           first.insert(key(h));
           return 0.0;
@@ -396,7 +392,7 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
     int visited = 0;
     InterpretationTreeStats resumed;
     SearchUnsearchedBranches(
-        edges, lines, prior, options, caps, branches,
+        {&edges, &lines, &prior, &caps}, options, branches,
         [&](const Hypothesis& h) {
           ++visited;
           EXPECT_EQ(first.count(key(h)), 0u);
@@ -419,20 +415,18 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
   EXPECT_GT(leaves_seen, 0);
 }
 
-// Seed 5 wide scene 395 (ninth round): the budget runs out in the root's first branch (edge 54's)
-// while the truth is in a sibling (edge 61's) of the same bound. Without the unsearched root
-// branches a pose 0.96 m / 7.8 deg off (two unreported false pairs) is answered; with them, the
-// truth. (The round's first case, seed 1 wide 414, no longer exhausts its budget since the prior's
-// bounds entered the refinement.)
+// Seed 1 wide scene 307: the budget runs out before the root branch holding the truth is
+// searched. Without the unsearched root branches a wrong pose (about 1 m off) is answered; with
+// them, the truth.
 TEST_F(LocalizerTest, TruthInAnUnsearchedRootBranchIsFound) {
   SyntheticScene scene;
   LocalizerOptions without;
   without.unsearched_branches_share = 0.0;
-  const LocalizationResult before = LocalizeBenchmarkScene(5, 2.0, 45.0, 395, &scene, without);
+  const LocalizationResult before = LocalizeBenchmarkScene(1, 2.0, 45.0, 307, &scene, without);
   ASSERT_TRUE(before.found) << before.reason;  // the scene exercises the mechanism
   EXPECT_GT(std::hypot(before.pose.x - scene.truth.x, before.pose.y - scene.truth.y),
             kWrongPositionM);
-  const LocalizationResult r = LocalizeBenchmarkScene(5, 2.0, 45.0, 395, &scene);
+  const LocalizationResult r = LocalizeBenchmarkScene(1, 2.0, 45.0, 307, &scene);
   ASSERT_TRUE(r.found) << r.reason;
   EXPECT_TRUE(r.budget_exhausted);
   EXPECT_LE(std::hypot(r.pose.x - scene.truth.x, r.pose.y - scene.truth.y), kWrongPositionM);

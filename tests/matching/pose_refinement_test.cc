@@ -17,16 +17,6 @@ constexpr double kJacobianTol = 1e-5;   // relative, analytic vs central differe
 constexpr double kPositionTolM = 1e-6;  // exact data: the truth is recovered
 constexpr double kHeadingTolRad = 1e-7;
 
-std::vector<LineMatch> ExactMatches(const testing::HallFixture& hall,
-                                    const testing::ExactView& view) {
-  std::vector<LineMatch> matches;
-  for (const ProjectedEdge& p : view.pieces) {
-    const ModelEdge& e = hall.model().edges()[p.edge_id];
-    matches.push_back({e.segment.a, e.segment.b, p.image});
-  }
-  return matches;
-}
-
 // `pose` with parameter k (0 heading, 1 x, 2 y: the Jacobians' column order) moved by `step`.
 Pose3Dof Moved(Pose3Dof pose, int k, double step) {
   (k == 0 ? pose.heading : k == 1 ? pose.x : pose.y) += step;
@@ -39,7 +29,7 @@ TEST(PoseRefinement, AnalyticJacobianMatchesFiniteDifferences) {
   for (int v = 0; v < 20; ++v) {
     const testing::ExactView view = hall.RandomView(rng);
     const Pose3Dof pose{view.pose.x + 0.1, view.pose.y - 0.05, view.pose.heading + 0.02};
-    for (const LineMatch& m : ExactMatches(hall, view)) {
+    for (const LineMatch& m : testing::ExactLineMatches(hall, view)) {
       Eigen::Matrix<double, 2, 3> analytic;
       EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, pose, &analytic);
       for (int k = 0; k < 3; ++k) {
@@ -66,7 +56,7 @@ TEST(PoseRefinement, ResidualIsZeroAtTheTruthAndConvergesFromThePrior) {
   constexpr int kViews = 50;
   for (int v = 0; v < kViews; ++v) {
     const testing::ExactView view = hall.RandomView(rng, 6);
-    const std::vector<LineMatch> matches = ExactMatches(hall, view);
+    const std::vector<LineMatch> matches = testing::ExactLineMatches(hall, view);
     const Pose3Dof truth = view.pose.Planar();
     for (const LineMatch& m : matches) {
       EXPECT_LT(EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, truth).norm(),
@@ -96,15 +86,16 @@ TEST(PoseRefinement, ScaleJacobianMatchesFiniteDifferences) {
   for (int v = 0; v < 10; ++v) {
     const testing::ExactView view = hall.RandomView(rng);
     const Pose3Dof pose = view.pose.Planar();
-    for (const LineMatch& m : ExactMatches(hall, view)) {
+    for (const LineMatch& m : testing::ExactLineMatches(hall, view)) {
       Eigen::Matrix<double, 2, 4> analytic;
-      EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, pose, 1.01, &analytic);
+      EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, {pose, 1.01},
+                        &analytic);
       const double step = 1e-6;
       const Eigen::Vector2d numeric =
-          (EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, pose, 1.01 + step,
-                             nullptr) -
-           EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt, pose, 1.01 - step,
-                             nullptr)) /
+          (EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt,
+                             {pose, 1.01 + step}, nullptr) -
+           EndpointResiduals(m, hall.camera(), view.pose.height, view.pose.tilt,
+                             {pose, 1.01 - step}, nullptr)) /
           (2.0 * step);
       for (int r = 0; r < 2; ++r) {
         EXPECT_NEAR(analytic(r, 3), numeric[r], kJacobianTol * std::max(1.0, std::abs(numeric[r])));
@@ -157,7 +148,7 @@ TEST(PoseRefinement, FocalScaleAbsorbsACalibrationError) {
 std::vector<LineMatch> NoisyMatches(const testing::HallFixture& hall,
                                     const testing::ExactView& view, std::mt19937_64& rng) {
   std::normal_distribution<double> pixel(0.0, 1.0);
-  std::vector<LineMatch> matches = ExactMatches(hall, view);
+  std::vector<LineMatch> matches = testing::ExactLineMatches(hall, view);
   for (LineMatch& m : matches) {
     m.observed.a += Eigen::Vector2d(pixel(rng), pixel(rng));
     m.observed.b += Eigen::Vector2d(pixel(rng), pixel(rng));
@@ -252,7 +243,7 @@ TEST(PoseBounds, PoseIsHeldAtTheBorder) {
   int held = 0;
   for (int v = 0; v < 20; ++v) {
     const testing::ExactView view = hall.RandomView(rng, 6);
-    const std::vector<LineMatch> matches = ExactMatches(hall, view);
+    const std::vector<LineMatch> matches = testing::ExactLineMatches(hall, view);
     const Pose3Dof truth = view.pose.Planar();
     const double away = angle(rng);
     const Pose3Dof centre{truth.x + std::cos(away), truth.y + std::sin(away),

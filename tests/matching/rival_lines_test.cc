@@ -9,7 +9,9 @@
 #include <limits>
 #include <numeric>
 
+#include "matching/hypothesis_trimming.h"
 #include "matching/pose_refinement.h"
+#include "matching/reported_pairs.h"
 #include "matching/verification.h"
 #include "models/synth/synthetic_scenes.h"
 
@@ -107,8 +109,8 @@ class RivalLinesTest : public ::testing::Test {
 
   // The pairs reported when line `line`, shifted by `offset_px`, is added to the scene's lines
   // (its index is scene.lines.size()).
-  std::vector<std::pair<int, int>> ReportedWithTwin(const SyntheticScene& scene, int line,
-                                                    double offset_px) {
+  std::vector<std::pair<int, int>> ReportedWithParallelLine(const SyntheticScene& scene, int line,
+                                                            double offset_px) {
     std::vector<Segment2> lines = scene.lines;
     lines.push_back(Shifted(lines[line], offset_px));
     const VerificationContext context = Context(scene, lines);
@@ -130,19 +132,19 @@ TEST_F(RivalLinesTest, AParallelLineWithinTheNoiseContestsTheEdgeBeyondTheGateIt
     // A pair reported when the edge's exact image is alone.
     const auto [edge, line] = PinnedReportedPair(scene);
     if (edge < 0) continue;
-    const int twin = static_cast<int>(scene.lines.size());
+    const int parallel = static_cast<int>(scene.lines.size());
     // A parallel line over the same stretch within the noise: neither line is the edge's image
     // with odds of e^report_nats; the other pairs are still reported.
     const std::vector<std::pair<int, int>> contested =
-        ReportedWithTwin(scene, line, kWithinNoisePx);
+        ReportedWithParallelLine(scene, line, kWithinNoisePx);
     EXPECT_FALSE(Has(contested, {edge, line})) << "scene " << scene.index;
-    EXPECT_FALSE(Has(contested, {edge, twin})) << "scene " << scene.index;
+    EXPECT_FALSE(Has(contested, {edge, parallel})) << "scene " << scene.index;
     EXPECT_FALSE(contested.empty()) << "scene " << scene.index;
     // The same line far beyond the noise is no rival.
     const std::vector<std::pair<int, int>> uncontested =
-        ReportedWithTwin(scene, line, kBeyondGatePx);
+        ReportedWithParallelLine(scene, line, kBeyondGatePx);
     EXPECT_TRUE(Has(uncontested, {edge, line})) << "scene " << scene.index;
-    EXPECT_FALSE(Has(uncontested, {edge, twin})) << "scene " << scene.index;
+    EXPECT_FALSE(Has(uncontested, {edge, parallel})) << "scene " << scene.index;
     ++tested;
   }
   EXPECT_GE(tested, kScenes / 2);
@@ -165,8 +167,9 @@ TEST_F(RivalLinesTest, AStandInForAnUndetectedImageIsNotReportedAtThePoseOfTheOt
     Eigen::Matrix4d covariance;
     ASSERT_TRUE(DeletedPose(exact, truth, index, &others, &covariance));
     Eigen::Matrix<double, 3, 4> d_line;
-    ProjectedEdgeLine(edges_[edge].a, edges_[edge].b, camera_, scene.height, scene.tilt, others,
-                      truth.refinement.focal_scale, &d_line);
+    ProjectedEdgeLine(edges_[edge].a, edges_[edge].b, camera_,
+                      ViewOf(others, scene.height, scene.tilt), truth.refinement.focal_scale,
+                      &d_line);
     const Eigen::Vector2d mid = scene.lines[line].Mid();
     const Eigen::RowVector4d j = Eigen::Vector3d(mid.x(), mid.y(), 1.0).transpose() * d_line;
     const double sigma_px =

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "matching/pose_refinement.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/occlusion.h"
@@ -66,6 +67,17 @@ class HallFixture {
   OcclusionTester occlusion_;
   CameraIntrinsics camera_;
 };
+
+// The correspondences of an exact view: each visible piece's image matched to its whole model
+// edge (identity whitening).
+inline std::vector<LineMatch> ExactLineMatches(const HallFixture& hall, const ExactView& view) {
+  std::vector<LineMatch> matches;
+  for (const ProjectedEdge& p : view.pieces) {
+    const ModelEdge& e = hall.model().edges()[p.edge_id];
+    matches.push_back({e.segment.a, e.segment.b, p.image});
+  }
+  return matches;
+}
 
 // The paper's line noise (Table 1): the segment rotated about its midpoint by N(0, angle) and
 // shifted along its normal by N(0, offset); the ends shortened by up to `shorten` each.

@@ -46,6 +46,26 @@ TEST(CaoReader, EdgesAreLinesThenFaceEdgesDeduplicated) {
   EXPECT_EQ(model.edges()[4].face, 1);
 }
 
+TEST(CaoReader, EdgesAreNamedAfterTheirLineOrTheirFaces) {
+  const std::string text =
+      "V1\n5\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n"
+      "2\n0 4 name=\"north door jamb\" useLod=true\n1 2\n"  // quoted, with spaces; unnamed
+      "0\n"
+      "2\n3 0 1 2 name=floor_a\n3 0 2 3 name=\"floor_b\"\n"  // sharing the diagonal 0-2
+      "0\n0\n";
+  const CaoModel cao = ParseCao(text, "mem.cao", nullptr);
+  EXPECT_EQ(cao.line_names, (std::vector<std::string>{"north door jamb", ""}));
+  EXPECT_EQ(cao.face_names, (std::vector<std::string>{"floor_a", "floor_b"}));
+  const WireframeModel model = WireframeModel::FromCao(cao);
+  ASSERT_EQ(model.edges().size(), 6u);
+  EXPECT_EQ(model.edges()[0].name, "north door jamb");  // the line's own name
+  EXPECT_EQ(model.edges()[1].name, "floor_a");          // an unnamed line on face floor_a
+  EXPECT_EQ(model.edges()[2].name, "floor_a");          // 0-1
+  EXPECT_EQ(model.edges()[3].name, "floor_a/floor_b");  // 2-0, the shared diagonal
+  EXPECT_EQ(model.edges()[4].name, "floor_b");          // 2-3
+  EXPECT_EQ(model.faces()[1].name, "floor_b");
+}
+
 TEST(CaoReader, HandlesCommentsAndWindowsLineEndings) {
   const std::string text =
       "V1\r\n# comment\r\n3 # points\r\n0 0 0\r\n1 0 0 # x\r\n0 1 0\r\n0\r\n0\r\n1\r\n3 0 1 2\r\n";

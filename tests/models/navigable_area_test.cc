@@ -59,8 +59,8 @@ TEST(NavigableArea, HallFromWallsAgreesWithTheHandWrittenArea) {
   EXPECT_EQ(sidecar.source(), "sidecar hall.nav.json");
   // The partition, attached to the north wall, is a notch of the outer boundary; the pillars are
   // holes.
-  EXPECT_EQ(derived.outer().vertices.size(), 8u);
-  EXPECT_EQ(derived.holes().size(), 2u);
+  EXPECT_EQ(derived.parts().at(0).outer.vertices.size(), 8u);
+  EXPECT_EQ(derived.parts().at(0).holes.size(), 2u);
   EXPECT_NEAR(derived.Area(), 14.0 * 9.0 - 0.2 * 3.5 - 2 * 0.25, kAreaTolM2);
   EXPECT_NEAR(derived.Area(), sidecar.Area(), kAreaTolM2);
   int inside = 0;
@@ -92,8 +92,8 @@ TEST(NavigableArea, RoomFromWallsKeepsTheOpenCabinetOutByClearance) {
   const NavigableArea area = NavigableArea::FromModel(WireframeModel::Load(kModels + "/room.cao"));
   EXPECT_EQ(area.source(), "walls (6 faces)");
   // The cabinet's two faces dangle from the north wall: no hole, no spike in the boundary.
-  EXPECT_EQ(area.outer().vertices.size(), 4u);
-  EXPECT_TRUE(area.holes().empty());
+  EXPECT_EQ(area.parts().at(0).outer.vertices.size(), 4u);
+  EXPECT_TRUE(area.parts().at(0).holes.empty());
   EXPECT_NEAR(area.Area(), 20.0, kAreaTolM2);
   EXPECT_TRUE(area.Contains({2.5, 2.0}));
   EXPECT_FALSE(area.Contains({4.0, 3.6}));  // in the cabinet, within the clearance of its faces
@@ -104,7 +104,7 @@ TEST(NavigableArea, ObjectWithoutEnclosingWallsFallsBackToItsBoundingBox) {
   const WireframeModel cube = WireframeModel::Load(kVispCube);
   const NavigableArea area = NavigableArea::FromModel(cube);
   EXPECT_EQ(area.source(), "bounding box + 2 m (no enclosing walls)");
-  ASSERT_EQ(area.holes().size(), 1u);  // the cube's footprint
+  ASSERT_EQ(area.parts().at(0).holes.size(), 1u);  // the cube's footprint
   const double side = 0.084;
   EXPECT_NEAR(area.Area(), (side + 4.0) * (side + 4.0) - side * side, kAreaTolM2);
   EXPECT_FALSE(area.Contains({-0.042, 0.042}));
@@ -116,7 +116,7 @@ TEST(NavigableArea, ModelWithoutFacesIsItsBoundingBoxGrown) {
   const NavigableArea area =
       NavigableArea::FromModel(FromText("V1\n2\n0 0 0\n1 2 3\n1\n0 1\n0\n0\n0\n0\n"));
   EXPECT_EQ(area.source(), "bounding box + 2 m (no enclosing walls)");
-  EXPECT_TRUE(area.holes().empty());
+  EXPECT_TRUE(area.parts().at(0).holes.empty());
   EXPECT_NEAR(area.Area(), 5.0 * 6.0, kAreaTolM2);
 }
 
@@ -156,7 +156,7 @@ TEST(NavigableArea, ClosedNonConvexObstacleBecomesAHole) {
   text += "0\n0\n10\n" + faces + "0\n0\n";
   const NavigableArea area = NavigableArea::FromModel(FromText(text));
   EXPECT_EQ(area.source(), "walls (10 faces)");
-  ASSERT_EQ(area.holes().size(), 1u);
+  ASSERT_EQ(area.parts().at(0).holes.size(), 1u);
   EXPECT_NEAR(area.Area(), 48.0 - 3.0, kAreaTolM2);
   EXPECT_FALSE(area.Contains({3.5, 3.5}));
   EXPECT_TRUE(area.Contains({4.5, 3.5}));  // in the L's notch, 0.5 m from its faces

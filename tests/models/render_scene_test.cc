@@ -77,13 +77,13 @@ TEST(ZBuffer, PlaneInverseDepthMatchesRayIntersection) {
   const Eigen::Vector3d n = Eigen::Vector3d(0.3, -0.2, 0.9).normalized();
   const double d = 2.5, px = 800, py = 820, u0 = 330, v0 = 250;
   Eigen::Vector3d c;
-  ASSERT_TRUE(PlaneInverseDepth(n, d, px, py, u0, v0, &c));
+  ASSERT_TRUE(PlaneInverseDepth(n, d, {px, py, u0, v0}, &c));
   for (const Eigen::Vector2d& uv : {Eigen::Vector2d(10, 20), Eigen::Vector2d(600, 400)}) {
     const Eigen::Vector3d ray((uv.x() - u0) / px, (uv.y() - v0) / py, 1.0);
     const double z = d / n.dot(ray);  // X = z ray on the plane
     EXPECT_NEAR(c.dot(Eigen::Vector3d(uv.x(), uv.y(), 1.0)), 1.0 / z, kTol);
   }
-  EXPECT_FALSE(PlaneInverseDepth(n, 0.0, px, py, u0, v0, &c));  // through the optical centre
+  EXPECT_FALSE(PlaneInverseDepth(n, 0.0, {px, py, u0, v0}, &c));  // through the optical centre
 }
 
 TEST(ZBuffer, ClipsPolygonsAtTheNearPlane) {

@@ -1,4 +1,4 @@
-// The pose conventions of method.md, checked on hand-computed cases.
+// The pose conventions of docs/conventions.md, checked on hand-computed cases.
 #include "models/robot_pose.h"
 
 #include <gtest/gtest.h>

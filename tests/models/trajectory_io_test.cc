@@ -96,9 +96,12 @@ TEST(TrajectoryIo, MalformedPriorsNameFileAndLine) {
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ParsePriors(header + "0,1,,3,1.3,5\n", "p.csv"); }).find("p.csv:2:"),
             std::string::npos);
-  EXPECT_NE(
-      ErrorOf([&] { ParsePriors(header + "0,1,2,3,-1,5\n", "p.csv"); }).find("p.csv:2: height"),
-      std::string::npos);
+  for (const char* height : {"-1", "0"}) {  // a camera height is above the floor
+    EXPECT_NE(ErrorOf([&] {
+                ParsePriors(header + "0,1,2,3," + height + ",5\n", "p.csv");
+              }).find("p.csv:2: height"),
+              std::string::npos);
+  }
   EXPECT_NE(ErrorOf([&] {
               ParsePriors(header + "0,1,2,3,1,5\n0,1,2,3,1,5\n", "p.csv");
             }).find("p.csv:3: time does not increase"),

@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <random>
 
 namespace linetrack {
@@ -84,6 +86,76 @@ Eigen::Vector2d UndistortedNormalised(const CameraIntrinsics& camera, double u, 
   return x;
 }
 
+// Pixel rectangle [u0, u1) x [v0, v1) that holds the board's image: the bounding box of its
+// outline's image (64 points per side), grown by a margin; the whole image when part of the
+// outline lies behind the camera. Pixels outside it see only the background.
+cv::Rect BoardImageBounds(const CameraIntrinsics& camera, const Eigen::Isometry3d& cam_from_board,
+                          const Eigen::AlignedBox2d& extent) {
+  constexpr int kPerSide = 64;
+  constexpr int kMarginPx = 3;
+  const cv::Rect whole(0, 0, camera.width, camera.height);
+  double u_lo = 1e300, v_lo = 1e300, u_hi = -1e300, v_hi = -1e300;
+  const int around[] = {0, 1, 3, 2};  // Eigen's corner ids in order around the box
+  for (int side = 0; side < 4; ++side) {
+    const Eigen::Vector2d a =
+        extent.corner(static_cast<Eigen::AlignedBox2d::CornerType>(around[side]));
+    const Eigen::Vector2d b =
+        extent.corner(static_cast<Eigen::AlignedBox2d::CornerType>(around[(side + 1) % 4]));
+    for (int k = 0; k < kPerSide; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / kPerSide);
+      const Eigen::Vector3d q = cam_from_board * Eigen::Vector3d(p.x(), p.y(), 0.0);
+      if (!(q.z() > 0.0)) return whole;
+      const Eigen::Vector2d uv = camera.Distort(camera.Project(q));
+      u_lo = std::min(u_lo, uv.x());
+      u_hi = std::max(u_hi, uv.x());
+      v_lo = std::min(v_lo, uv.y());
+      v_hi = std::max(v_hi, uv.y());
+    }
+  }
+  const cv::Rect box(static_cast<int>(std::floor(u_lo)) - kMarginPx,
+                     static_cast<int>(std::floor(v_lo)) - kMarginPx,
+                     static_cast<int>(std::ceil(u_hi - u_lo)) + 2 * kMarginPx + 1,
+                     static_cast<int>(std::ceil(v_hi - v_lo)) + 2 * kMarginPx + 1);
+  return box & whole;
+}
+
+using SampleRays = std::vector<Eigen::Vector2d>;
+
+// Normalised undistorted coordinates of the n x n sub-pixel samples of every pixel, in the order
+// RenderBoard visits them: ((v * width + u) * n + a) * n + b for pixel (u, v), sample row a and
+// column b. They depend on the camera alone, so the views of one camera share one table (the
+// last one computed is kept).
+std::shared_ptr<const SampleRays> UndistortedSamples(const CameraIntrinsics& camera, int n) {
+  static std::mutex mutex;
+  static CameraIntrinsics cached_camera;
+  static int cached_n = 0;
+  static std::shared_ptr<const SampleRays> cached;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const CameraIntrinsics& c = cached_camera;
+  if (cached && cached_n == n && c.width == camera.width && c.height == camera.height &&
+      c.px == camera.px && c.py == camera.py && c.u0 == camera.u0 && c.v0 == camera.v0 &&
+      c.has_distortion == camera.has_distortion && c.kud == camera.kud) {
+    return cached;
+  }
+  auto rays = std::make_shared<SampleRays>();
+  rays->reserve(static_cast<size_t>(camera.width) * camera.height * n * n);
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      for (int a = 0; a < n; ++a) {
+        for (int b = 0; b < n; ++b) {
+          // Pixel (u, v) covers [u - 0.5, u + 0.5] x [v - 0.5, v + 0.5] (OpenCV's convention).
+          const double su = u - 0.5 + (b + 0.5) / n, sv = v - 0.5 + (a + 0.5) / n;
+          rays->push_back(UndistortedNormalised(camera, su, sv));
+        }
+      }
+    }
+  }
+  cached_camera = camera;
+  cached_n = n;
+  cached = std::move(rays);
+  return cached;
+}
+
 double Uniform(std::mt19937_64& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
@@ -122,17 +194,18 @@ cv::Mat RenderBoard(const PatternSpec& pattern, const CameraIntrinsics& camera,
   h.col(2) = cam_from_board.translation();
   const Eigen::Matrix3d board_from_ray = h.inverse();
   const int n = options.supersampling;
-  cv::Mat image(camera.height, camera.width, CV_64F);
-  for (int v = 0; v < camera.height; ++v) {
+  const std::shared_ptr<const SampleRays> rays = UndistortedSamples(camera, n);
+  cv::Mat image(camera.height, camera.width, CV_64F, cv::Scalar(options.background));
+  const cv::Rect bounds = BoardImageBounds(camera, cam_from_board, BoardExtent(pattern, options));
+  for (int v = bounds.y; v < bounds.y + bounds.height; ++v) {
     double* row = image.ptr<double>(v);
-    for (int u = 0; u < camera.width; ++u) {
+    for (int u = bounds.x; u < bounds.x + bounds.width; ++u) {
+      const Eigen::Vector2d* x =
+          rays->data() + (static_cast<size_t>(v) * camera.width + u) * static_cast<size_t>(n * n);
       double sum = 0.0;
       for (int a = 0; a < n; ++a) {
-        for (int b = 0; b < n; ++b) {
-          // Pixel (u, v) covers [u - 0.5, u + 0.5] x [v - 0.5, v + 0.5] (OpenCV's convention).
-          const double su = u - 0.5 + (b + 0.5) / n, sv = v - 0.5 + (a + 0.5) / n;
-          const Eigen::Vector2d x = UndistortedNormalised(camera, su, sv);
-          const Eigen::Vector3d q = board_from_ray * Eigen::Vector3d(x.x(), x.y(), 1.0);
+        for (int b = 0; b < n; ++b, ++x) {
+          const Eigen::Vector3d q = board_from_ray * Eigen::Vector3d(x->x(), x->y(), 1.0);
           double value = options.background;
           if (q.z() > 0.0) {  // the ray meets the plane in front of the camera
             const double albedo = texture(q.x() / q.z(), q.y() / q.z());

@@ -28,6 +28,9 @@ constexpr double kMaxRotationErrorDeg = 1.0;
 // reaches 12.5 mm and 7.6 degrees on the same frames.
 constexpr double kAloneMaxTranslationErrorM = 0.015;
 constexpr double kAloneMaxRotationErrorDeg = 6.0;
+// Frames whose pose the integrity monitor may withhold with the castle alone: where its edges do
+// not fix the pose (the tracker still follows them).
+constexpr int kAloneMaxWithheldFrames = 2;
 
 struct Worst {
   double object_translation = 0.0;  // |t_cMo - t_cMo_true| (metres)
@@ -66,7 +69,12 @@ Worst TrackCastle(const std::string& model) {
     const FrameReport report =
         sequence.Process(testing::ReadGrey(CastleImage(i)), (i - 1) / 30.0, std::nullopt);
     EXPECT_EQ(report.status, TrackStatus::kTracking) << "frame " << i << ": " << report.note;
-    if (report.cam_from_world) worst.Add(*report.cam_from_world, CastleTruth(i));
+    if (report.cam_from_world) {
+      worst.Add(*report.cam_from_world, CastleTruth(i));
+    } else {
+      EXPECT_EQ(report.uncertainty.status, IntegrityStatus::kLost) << "frame " << i;
+      EXPECT_FALSE(report.uncertainty.reason.empty()) << "frame " << i;
+    }
   }
   return worst;
 }
@@ -112,7 +120,7 @@ TEST(CastleSimu, CastleModelAloneTracksEveryFrameBetterThanVisp) {
   const Worst visp = TrackCastleWithVisp(model);
   Report("linetrack, chateau.cao", worst);
   Report("ViSP track(), chateau.cao", visp);
-  EXPECT_EQ(worst.tracked, testing::kCastleFrames);
+  EXPECT_GE(worst.tracked, testing::kCastleFrames - kAloneMaxWithheldFrames);
   EXPECT_LE(worst.object_translation, kAloneMaxTranslationErrorM);
   EXPECT_LE(worst.rotation_deg, kAloneMaxRotationErrorDeg);
   EXPECT_LT(worst.rotation_deg, visp.rotation_deg);

@@ -118,8 +118,8 @@ TEST(EdgeRefinement, BringsAPerturbedPoseBackOnTheEdges) {
   Eigen::Isometry3d start = truth;
   start.pretranslate(Eigen::Vector3d(0.012, -0.01, 0.012));
   start.prerotate(Eigen::AngleAxisd(DegToRad(0.1), Eigen::Vector3d(0.3, 1.0, 0.2).normalized()));
-  const EdgeRefinement free =
-      RefineOnEdges(image, hall.camera.Undistorted(), edges, IntegerSites(hall, truth), start, {});
+  const EdgeRefinement free = RefineOnEdges(image, hall.camera.Undistorted(), edges,
+                                            IntegerSites(hall, truth), {start, std::nullopt}, {});
   ASSERT_TRUE(free.applied);
   const PoseDifference before = ComparePoses(start, truth);
   const PoseDifference after = ComparePoses(free.cam_from_world, truth);
@@ -129,8 +129,8 @@ TEST(EdgeRefinement, BringsAPerturbedPoseBackOnTheEdges) {
   EXPECT_LT(free.rms_after_px, free.rms_before_px);
   // 3 unknowns with the robot's height and tilt: the result keeps them exactly, roll zero.
   const EdgeRefinement robot =
-      RefineOnEdges(image, hall.camera.Undistorted(), edges, IntegerSites(hall, truth), start, {},
-                    KnownHeightTilt{hall.pose.height, hall.pose.tilt});
+      RefineOnEdges(image, hall.camera.Undistorted(), edges, IntegerSites(hall, truth),
+                    {start, KnownHeightTilt{hall.pose.height, hall.pose.tilt}}, {});
   ASSERT_TRUE(robot.applied);
   const RobotPose refined = RobotPoseFromCamFromWorld(robot.cam_from_world);
   EXPECT_NEAR(refined.height, hall.pose.height, 1e-9);
@@ -156,8 +156,8 @@ TEST(EdgeRefinement, AlignsAPredictionSeveralPixelsOff) {
   EdgeAlignmentOptions options;
   options.search_px = 20.0;
   const EdgeRefinement aligned =
-      AlignToEdges(image, hall.camera.Undistorted(), visible, predicted, options,
-                   KnownHeightTilt{hall.pose.height, hall.pose.tilt});
+      AlignToEdges(image, hall.camera.Undistorted(), visible,
+                   {predicted, KnownHeightTilt{hall.pose.height, hall.pose.tilt}}, options);
   ASSERT_TRUE(aligned.applied);
   EXPECT_LT(ComparePoses(aligned.cam_from_world, truth).translation, kRefinedPositionTolM);
   EXPECT_LT(RadToDeg(ComparePoses(aligned.cam_from_world, truth).rotation), kRefinedRotationTolDeg);
@@ -209,7 +209,7 @@ TEST(EdgeRefinement, SetsAsideAnEdgeOnAnUnmodelledParallelLine) {
     }
   }
   const KnownHeightTilt known{hall.pose.height, hall.pose.tilt};
-  const EdgeRefinement kept = RefineOnEdges(image, camera, edges, sites, truth, {}, known);
+  const EdgeRefinement kept = RefineOnEdges(image, camera, edges, sites, {truth, known}, {});
   ASSERT_TRUE(kept.applied);
   EXPECT_GE(kept.rejected_edges, 1);
   EXPECT_LT(ComparePoses(kept.cam_from_world, truth).translation, kRefinedPositionTolM);
@@ -219,7 +219,7 @@ TEST(EdgeRefinement, SetsAsideAnEdgeOnAnUnmodelledParallelLine) {
   EdgeRefinementOptions no_rejection;
   no_rejection.max_edge_rejections = 0;
   const EdgeRefinement pulled =
-      RefineOnEdges(image, camera, edges, sites, truth, no_rejection, known);
+      RefineOnEdges(image, camera, edges, sites, {truth, known}, no_rejection);
   ASSERT_TRUE(pulled.applied);
   EXPECT_EQ(pulled.rejected_edges, 0);
   EXPECT_GT(ComparePoses(pulled.cam_from_world, truth).translation,

@@ -7,9 +7,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/pan_tilt.h"
 #include "tracking/head/head_kinematics.h"
 #include "tracking/sim/simulated_head.h"
 
@@ -152,7 +155,7 @@ TEST(HeadKinematics, ForwardModelFollowsTheConventions) {
   EXPECT_TRUE(pose.linear().col(2).isApprox(Eigen::Vector3d::UnitY()));  // pan is CCW
   const double tilt = DegToRad(20.0);
   pose = BaseFromCamera(centred, 0.0, tilt);
-  // method.md: optical axis (cos t cos h, cos t sin h, -sin t).
+  // docs/conventions.md: optical axis (cos t cos h, cos t sin h, -sin t).
   EXPECT_TRUE(pose.linear().col(2).isApprox(Eigen::Vector3d(std::cos(tilt), 0, -std::sin(tilt))));
 }
 
@@ -196,12 +199,20 @@ Eigen::Matrix<double, 6, 1> TwistOfStep(const HeadGeometry& g, double pan, doubl
   return twist;
 }
 
+// The nominal geometries and a bracket a few centimetres and degrees off.
+std::vector<HeadGeometry> TestGeometries() {
+  HeadGeometry off = GeometryOf(HeadModel::kPtu46);
+  Eigen::Matrix<double, 6, 1> error;
+  error << 0.012, -0.02, 0.007, 0.03, -0.05, 0.04;
+  off.tilt_from_camera = MovedPose(off.tilt_from_camera, error);
+  return {GeometryOf(HeadModel::kPtu46), GeometryOf(HeadModel::kBiclops), off};
+}
+
 TEST(HeadKinematics, ServoJacobianMatchesFiniteDifferences) {
   const double h = 1e-7;
-  for (HeadModel model : {HeadModel::kPtu46, HeadModel::kBiclops}) {
-    const HeadGeometry geometry = GeometryOf(model);
+  for (const HeadGeometry& geometry : TestGeometries()) {
     for (const auto& q : kJoints) {
-      const Eigen::Matrix<double, 6, 2> J = CameraJacobian(model, q[0], q[1]);
+      const Eigen::Matrix<double, 6, 2> J = CameraJacobian(geometry, q[1]);
       const Eigen::Matrix<double, 6, 1> d_pan = TwistOfStep(geometry, q[0], q[1], h, 0.0, h);
       const Eigen::Matrix<double, 6, 1> d_tilt = TwistOfStep(geometry, q[0], q[1], 0.0, h, h);
       EXPECT_LT((J.col(0) - d_pan).norm(), kJacobianTol)
@@ -218,6 +229,48 @@ TEST(HeadKinematics, ServoJacobianMatchesFiniteDifferences) {
   EXPECT_TRUE(ParseHeadModel("ptu46", &parsed));
   EXPECT_EQ(parsed, HeadModel::kPtu46);
   EXPECT_FALSE(ParseHeadModel("ptu-d46", &parsed));
+}
+
+// The camera Jacobian of the nominal geometries is ViSP's vpPtu46 / vpBiclops cVe eJe (ViSP
+// counts the PTU's tilt upwards: its tilt column changes sign).
+TEST(HeadKinematics, NominalServoJacobianIsViSPs) {
+  for (const auto& q : kJoints) {
+    for (HeadModel model : {HeadModel::kPtu46, HeadModel::kBiclops}) {
+      const double sign = model == HeadModel::kPtu46 ? -1.0 : 1.0;
+      vpColVector visp_q(2);
+      visp_q[0] = q[0];
+      visp_q[1] = sign * q[1];
+      vpMatrix eJe;
+      vpVelocityTwistMatrix cVe;
+      if (model == HeadModel::kPtu46) {
+        vpPtu46().get_eJe(visp_q, eJe);
+        vpPtu46().get_cVe(cVe);
+      } else {
+        vpBiclops().get_eJe(visp_q, eJe);
+        vpBiclops().get_cVe(cVe);
+      }
+      const vpMatrix visp = static_cast<vpMatrix>(cVe) * eJe;
+      const Eigen::Matrix<double, 6, 2> ours = CameraJacobian(GeometryOf(model), q[1]);
+      for (int r = 0; r < 6; ++r) {
+        EXPECT_NEAR(ours(r, 0), visp[r][0], kPoseTol) << "row " << r;
+        EXPECT_NEAR(ours(r, 1), sign * visp[r][1], kPoseTol) << "row " << r;
+      }
+    }
+  }
+}
+
+TEST(HeadKinematics, GeometryCheckRefusesNonRigidMounts) {
+  std::string why;
+  EXPECT_TRUE(GeometryOf(HeadModel::kPtu46).Check(&why));
+  HeadGeometry g = GeometryOf(HeadModel::kPtu46);
+  g.tilt_from_camera.linear() *= 1.01;
+  EXPECT_FALSE(g.Check(&why));
+  g = GeometryOf(HeadModel::kPtu46);
+  g.tilt_from_camera.translation().x() = std::nan("");
+  EXPECT_FALSE(g.Check(&why));
+  g = GeometryOf(HeadModel::kPtu46);
+  g.level_from_base = -Eigen::Matrix3d::Identity();  // a reflection
+  EXPECT_FALSE(g.Check(&why));
 }
 
 }  // namespace

@@ -72,8 +72,10 @@ std::unique_ptr<SimulatedLiveRig> Rig(const SimCameraOptions& camera, const Live
                                       double pan_offset, double tilt_offset) {
   SimHeadStart start;
   start.offset_from_target = Eigen::Vector2d(pan_offset, tilt_offset);
-  return std::make_unique<SimulatedLiveRig>(Hall(), &HallArea(), PaperCamera(), camera,
-                                            SimulatedHeadOptions{}, loop, start);
+  return std::make_unique<SimulatedLiveRig>(
+      Hall(), &HallArea(), PaperCamera(),
+      SimulatedLiveRigOptions{
+          camera, SimulatedHeadOptions{}, NominalBelief(camera, loop), start, {}});
 }
 
 // Every frame: joints within their limits, head rates and commands within the maximum speeds.
@@ -232,9 +234,10 @@ TEST(LiveLoop, ServosAPtuThroughItsSerialProtocol) {
   const SimCameraOptions options = StillBase({3.0, 1.5, DegToRad(20.0)});
   SimulatedCamera camera(Hall(), &HallArea(), PaperCamera(), options);
   double pan = 0.0, tilt = 0.0;
-  ASSERT_TRUE(HeadAnglesLookingAt(camera.geometry(),
-                                  WorldFromHeadBase(camera.BaseAt(0.0), camera.crossing_height()),
-                                  kPillarCorner, &pan, &tilt));
+  ASSERT_TRUE(HeadAnglesLookingAt(
+      camera.geometry(),
+      WorldFromHeadBase(camera.geometry(), camera.BaseAt(0.0), camera.crossing_height()),
+      kPillarCorner, &pan, &tilt));
   const double arcsec = driver->unit().pan_resolution_arcsec;
   emulator->SetPositions(std::round(PtuRadiansToCounts(pan + DegToRad(10.0), arcsec, 1)),
                          std::round(PtuRadiansToCounts(tilt + DegToRad(5.0), arcsec, -1)));
@@ -244,9 +247,9 @@ TEST(LiveLoop, ServosAPtuThroughItsSerialProtocol) {
   LiveLoopOptions loop_options;
   loop_options.target = kPillarCorner;
   loop_options.crossing_height = camera.crossing_height();
-  LiveLoop loop(
-      &camera, driver.get(), &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
-      PaperCamera(), loop_options);
+  LiveLoop loop(LiveLoopParts{&camera, driver.get(), &truth,
+                              [&camera](double t) { return camera.OdometryAt(t); }},
+                Hall(), PaperCamera(), loop_options);
   LiveIteration it;
   double start_error_px = 0.0, late_max_error_px = 0.0;
   for (int k = 0; k < 150; ++k) {  // 5 s
@@ -306,9 +309,10 @@ TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
   const SimCameraOptions options = StillBase({3.0, 1.5, DegToRad(20.0)});
   SimulatedCamera camera(Hall(), &HallArea(), PaperCamera(), options);
   double pan = 0.0, tilt = 0.0;
-  ASSERT_TRUE(HeadAnglesLookingAt(camera.geometry(),
-                                  WorldFromHeadBase(camera.BaseAt(0.0), camera.crossing_height()),
-                                  kPillarCorner, &pan, &tilt));
+  ASSERT_TRUE(HeadAnglesLookingAt(
+      camera.geometry(),
+      WorldFromHeadBase(camera.geometry(), camera.BaseAt(0.0), camera.crossing_height()),
+      kPillarCorner, &pan, &tilt));
   SimulatedHeadOptions head_options;
   head_options.initial_pan = pan + DegToRad(10.0);
   SimulatedHead sim_head(head_options);
@@ -319,8 +323,8 @@ TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
   loop_options.target = kPillarCorner;
   loop_options.crossing_height = camera.crossing_height();
   LiveLoop loop(
-      &camera, &head, &truth, [&camera](double t) { return camera.OdometryAt(t); }, Hall(),
-      PaperCamera(), loop_options);
+      LiveLoopParts{&camera, &head, &truth, [&camera](double t) { return camera.OdometryAt(t); }},
+      Hall(), PaperCamera(), loop_options);
   for (int k = 0; k < 5; ++k)
     ASSERT_EQ(loop.Step().command, HeadCommand::kVelocity);  // turning
   head.refuse = true;
@@ -339,8 +343,10 @@ TEST(LiveLoop, StopsTheHeadWhenAVelocityCommandIsRefused) {
 
 TEST(LiveLoop, TargetDefaultsToTheCentroidOfTheVisibleModel) {
   const SimCameraOptions camera = StillBase({3.0, 1.5, DegToRad(20.0)});
-  SimulatedLiveRig rig(Hall(), &HallArea(), PaperCamera(), camera, SimulatedHeadOptions{},
-                       LiveLoopOptions{});
+  SimulatedLiveRig rig(
+      Hall(), &HallArea(), PaperCamera(),
+      SimulatedLiveRigOptions{
+          camera, SimulatedHeadOptions{}, NominalBelief(camera, LiveLoopOptions{}), {}, {}});
   const LiveIteration first = rig.loop().Step();
   ASSERT_TRUE(first.has_target);
   ASSERT_TRUE(rig.loop().target().has_value());

@@ -69,8 +69,10 @@ TrackedRun RunWithTracker(const SimCameraOptions& camera, const LiveLoopOptions&
   const std::unique_ptr<TrackerPoseEstimator> tracker = Tracker();
   SimHeadStart start;
   start.offset_from_target = start_offset;
-  SimulatedLiveRig rig(TheHall().model, &TheHall().area, TheHall().camera, camera,
-                       SimulatedHeadOptions{}, loop, start, PoseJitterOptions{}, tracker.get());
+  SimulatedLiveRig rig(TheHall().model, &TheHall().area, TheHall().camera,
+                       SimulatedLiveRigOptions{
+                           camera, SimulatedHeadOptions{}, NominalBelief(camera, loop), start, {}},
+                       tracker.get());
   TrackedRun run;
   for (int k = 0; k < frames; ++k) {
     run.iterations.push_back(rig.loop().Step());

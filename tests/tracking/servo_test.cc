@@ -7,9 +7,11 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/pan_tilt.h"
 #include "tracking/head/head_pointing.h"
 #include "tracking/servo/head_servo.h"
 
@@ -33,17 +35,34 @@ HeadLimits WideLimits() {
   return {-2.7, 2.7, -0.5, 0.8, 2.0, 2.0};
 }
 
+// The nominal geometries, and brackets a few centimetres and degrees off on tilted bases.
+std::vector<HeadGeometry> TestGeometries() {
+  std::vector<HeadGeometry> geometries = {GeometryOf(HeadModel::kPtu46),
+                                          GeometryOf(HeadModel::kBiclops)};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> shift(-0.02, 0.02), turn(-0.08, 0.08), base(-0.03, 0.03);
+  for (int k = 0; k < 4; ++k) {
+    HeadGeometry g = geometries[k % 2];
+    Eigen::Matrix<double, 6, 1> error;
+    error << shift(rng), shift(rng), shift(rng), turn(rng), turn(rng), turn(rng);
+    g.tilt_from_camera = MovedPose(g.tilt_from_camera, error);
+    g.level_from_base = LevelFromBaseRotation(base(rng), base(rng));
+    geometries.push_back(g);
+  }
+  return geometries;
+}
+
 TEST(HeadPointing, AnglesLookingAtAPointPutItOnTheOpticalAxis) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> xy(-6.0, 6.0), z(0.0, 3.0), heading(-kPi, kPi);
-  for (HeadModel model : {HeadModel::kPtu46, HeadModel::kBiclops}) {
-    const HeadGeometry geometry = GeometryOf(model);
+  for (const HeadGeometry& geometry : TestGeometries()) {
     for (int k = 0; k < 200; ++k) {
       const Pose3Dof base{xy(rng), xy(rng), heading(rng)};
       const Eigen::Vector3d target(xy(rng), xy(rng), z(rng));
       if ((target.head<2>() - Eigen::Vector2d(base.x, base.y)).norm() < 0.5) continue;
       double pan = 0.0, tilt = 0.0;
-      ASSERT_TRUE(HeadAnglesLookingAt(geometry, WorldFromHeadBase(base, 1.2), target, &pan, &tilt));
+      ASSERT_TRUE(HeadAnglesLookingAt(geometry, WorldFromHeadBase(geometry, base, 1.2), target,
+                                      &pan, &tilt));
       const Eigen::Vector3d seen = CamFromWorldOnHead(geometry, base, 1.2, pan, tilt) * target;
       EXPECT_GT(seen.z(), 0.0);
       EXPECT_NEAR(seen.x() / seen.z(), 0.0, kOnAxisTol);
@@ -52,8 +71,8 @@ TEST(HeadPointing, AnglesLookingAtAPointPutItOnTheOpticalAxis) {
   }
   // Closer to the pan axis than the PTU's lateral offset: no solution.
   double pan = 0.0, tilt = 0.0;
-  EXPECT_FALSE(HeadAnglesLookingAt(GeometryOf(HeadModel::kPtu46),
-                                   WorldFromHeadBase({0.0, 0.0, 0.0}, 1.0),
+  const HeadGeometry ptu = GeometryOf(HeadModel::kPtu46);
+  EXPECT_FALSE(HeadAnglesLookingAt(ptu, WorldFromHeadBase(ptu, {0.0, 0.0, 0.0}, 1.0),
                                    Eigen::Vector3d(0.05, 0.0, 1.0), &pan, &tilt));
 }
 
@@ -73,7 +92,29 @@ TEST(HeadPointing, CameraPoseOnTheHeadFollowsTheConventions) {
   EXPECT_NEAR(level.height, 1.3, kPoseTol);
   const Eigen::Vector2d left(-std::sin(base.heading), std::cos(base.heading));
   EXPECT_NEAR((Eigen::Vector2d(level.x, level.y) - Eigen::Vector2d(base.x, base.y)).dot(left),
-              ptu.camera_offset.y(), kPoseTol);
+              ptu.tilt_from_camera.translation().y(), kPoseTol);
+  // The upside-down camera looks the same way.
+  const HeadGeometry biclops = GeometryOf(HeadModel::kBiclops);
+  EXPECT_NEAR(CameraPoseOnHead(biclops, base, crossing, pan, tilt).heading, DegToRad(50.0),
+              kPoseTol);
+}
+
+TEST(HeadPointing, AnyMountGivesTheHeadingAndTiltOfItsOpticalAxis) {
+  for (const HeadGeometry& geometry : TestGeometries()) {
+    const Pose3Dof base{-1.0, 4.0, DegToRad(-75.0)};
+    const double crossing = CrossingHeightFor(geometry, 1.4);
+    EXPECT_NEAR(CameraPoseOnHead(geometry, base, crossing, 0.0, 0.0).height, 1.4, kPoseTol);
+    const double pan = DegToRad(-30.0), tilt = DegToRad(25.0);
+    const RobotPose pose = CameraPoseOnHead(geometry, base, crossing, pan, tilt);
+    const Eigen::Isometry3d cam_from_world =
+        CamFromWorldOnHead(geometry, base, crossing, pan, tilt);
+    // The optical axis of the pose agrees with the camera's; the centre is the camera's.
+    const Eigen::Vector3d axis = cam_from_world.linear().row(2).transpose();
+    EXPECT_LT((CamFromWorld(pose).linear().row(2).transpose() - axis).norm(), kPoseTol);
+    EXPECT_LT((CamFromWorld(pose).inverse().translation() - cam_from_world.inverse().translation())
+                  .norm(),
+              kPoseTol);
+  }
 }
 
 TEST(HeadServo, SaturationKeepsTheDirection) {
@@ -112,22 +153,24 @@ TEST(HeadServo, RatesTowardsAJointLimitShrinkToZero) {
 // One servo step through the exact kinematics: after dt the image error is (1 - lambda dt) e.
 TEST(HeadServo, OneStepReducesTheErrorAtTheGainThroughTheRealKinematics) {
   const CameraIntrinsics& camera = PaperCamera();
-  for (HeadModel model : {HeadModel::kPtu46, HeadModel::kBiclops}) {
-    const HeadGeometry geometry = GeometryOf(model);
+  const std::vector<HeadGeometry> geometries = TestGeometries();
+  for (size_t g = 0; g < geometries.size(); ++g) {
+    const HeadGeometry& geometry = geometries[g];
     HeadServoOptions options;
-    options.model = model;
+    options.geometry = geometry;
     options.target_motion_filter = 0.0;
     options.max_pan_rate = options.max_tilt_rate = 50.0;  // no saturation here
     HeadServo servo(options);
     const Pose3Dof base{1.0, 2.0, DegToRad(15.0)};
     const Eigen::Vector3d target(5.0, 4.0, 0.8);
     double pan0 = 0.0, tilt0 = 0.0;
-    ASSERT_TRUE(HeadAnglesLookingAt(geometry, WorldFromHeadBase(base, 1.2), target, &pan0, &tilt0));
+    ASSERT_TRUE(HeadAnglesLookingAt(geometry, WorldFromHeadBase(geometry, base, 1.2), target, &pan0,
+                                    &tilt0));
     const double pan = pan0 + DegToRad(4.0), tilt = tilt0 - DegToRad(2.0);
     const Eigen::Vector2d desired(300.0, 250.0);
     const Eigen::Vector3d seen = CamFromWorldOnHead(geometry, base, 1.2, pan, tilt) * target;
     const ServoStep step =
-        servo.Compute(0.0, seen, desired, camera, pan, tilt, {-3, 3, -1, 1, 100, 100});
+        servo.Compute(0.0, seen, desired, camera, {pan, tilt, {-3, 3, -1, 1, 100, 100}});
     ASSERT_TRUE(step.ok) << step.reason;
     EXPECT_FALSE(step.converged);
     EXPECT_FALSE(step.saturated);
@@ -147,7 +190,7 @@ TEST(HeadServo, OneStepReducesTheErrorAtTheGainThroughTheRealKinematics) {
     const Eigen::Vector2d e1 = camera.Project(after) - desired;
     const Eigen::Vector2d expected = (1.0 - step.gain * dt) * e0;
     EXPECT_LT((e1 - expected).norm(), kFirstOrderRelTol * (e0 - expected).norm())
-        << "model " << static_cast<int>(model);
+        << "geometry " << g;
   }
 }
 
@@ -161,16 +204,16 @@ TEST(HeadServo, HoldsAtConvergenceWithHysteresis) {
   auto at_pixel_offset = [&](double du) {
     return Eigen::Vector3d(du / camera.px * 4.0, 0.0, 4.0);  // 4 m ahead, du pixels right
   };
-  ServoStep s = servo.Compute(0.0, at_pixel_offset(1.0), desired, camera, 0, 0, WideLimits());
+  ServoStep s = servo.Compute(0.0, at_pixel_offset(1.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_FALSE(s.converged);  // 1 px > 0.5 px: not converged yet
   EXPECT_NE(s.pan_rate, 0.0);
-  s = servo.Compute(0.1, at_pixel_offset(0.2), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.1, at_pixel_offset(0.2), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);
   EXPECT_EQ(s.pan_rate, 0.0);
   EXPECT_EQ(s.tilt_rate, 0.0);
-  s = servo.Compute(0.2, at_pixel_offset(1.5), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.2, at_pixel_offset(1.5), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);  // still holding below 2 px
-  s = servo.Compute(0.3, at_pixel_offset(3.0), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(0.3, at_pixel_offset(3.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_FALSE(s.converged);
   EXPECT_LT(s.pan_rate, 0.0);  // target to the right: pan clockwise (negative)
 }
@@ -187,9 +230,9 @@ TEST(HeadServo, FollowsAMovingTargetInsteadOfHolding) {
   auto seen_at = [&](double t) {  // moving right, head fixed at zero
     return Eigen::Vector3d(speed_px_s * t / camera.px * depth, 0.0, depth);
   };
-  ServoStep s = servo.Compute(0.0, seen_at(0.0), desired, camera, 0, 0, WideLimits());
+  ServoStep s = servo.Compute(0.0, seen_at(0.0), desired, camera, {0, 0, WideLimits()});
   EXPECT_TRUE(s.converged);  // no motion known yet, error 0
-  s = servo.Compute(dt, seen_at(dt), desired, camera, 0, 0, WideLimits());
+  s = servo.Compute(dt, seen_at(dt), desired, camera, {0, 0, WideLimits()});
   EXPECT_NEAR(s.target_speed_px_s, speed_px_s, 1e-6);
   EXPECT_FALSE(s.converged);
   EXPECT_TRUE(s.compensated);
@@ -203,7 +246,7 @@ TEST(HeadServo, FollowsAMovingTargetInsteadOfHolding) {
 TEST(HeadServo, NoCommandForATargetBehindTheCamera) {
   HeadServo servo(HeadServoOptions{});
   const ServoStep s = servo.Compute(0.0, Eigen::Vector3d(0.0, 0.0, -2.0), {320.0, 240.0},
-                                    PaperCamera(), 0.0, 0.0, WideLimits());
+                                    PaperCamera(), {0.0, 0.0, WideLimits()});
   EXPECT_FALSE(s.ok);
   EXPECT_EQ(s.pan_rate, 0.0);
   EXPECT_NE(s.reason.find("behind"), std::string::npos);

@@ -229,5 +229,23 @@ TEST(RobotReadings, GroundTruthIsTheNearestPoseWithinTolerance) {
   EXPECT_EQ(MedianTimeStep({1.0}), 0.0);
 }
 
+TEST(EdgeTracker, FailuresSpeakOfTheSettingsNotOfViSPsApi) {
+  // ViSP 3.5's two forms of the message (vpMbEdgeTracker), with and without the counts.
+  const std::string with_counts = TrackingFailureReason(
+      "Not enough moving edges (12) to track the object: expected 38. Try to reduce the "
+      "threshold=0.4 using setGoodMovingEdgesRatioThreshold()");
+  EXPECT_EQ(with_counts.find("setGoodMovingEdgesRatioThreshold"), std::string::npos);
+  EXPECT_NE(with_counts.find("(12 where 38 were needed)"), std::string::npos) << with_counts;
+  EXPECT_NE(with_counts.find("<ecm><range><tracking>"), std::string::npos);
+  EXPECT_NE(with_counts.find("<ecm><contrast><edge_threshold>"), std::string::npos);
+  const std::string without_counts = TrackingFailureReason(
+      "Not enough moving edges to track the object. Try to reduce the threshold=0.4 using "
+      "setGoodMovingEdgesRatioThreshold()");
+  EXPECT_EQ(without_counts.find("setGoodMovingEdgesRatioThreshold"), std::string::npos);
+  EXPECT_EQ(without_counts.find("were needed"), std::string::npos);
+  EXPECT_EQ(TrackingFailureReason("Moving edges not initialized"),
+            "ViSP: Moving edges not initialized");
+}
+
 }  // namespace
 }  // namespace linetrack

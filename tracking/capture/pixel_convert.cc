@@ -30,14 +30,14 @@ bool IsBayer(PixelKind kind) {
          kind == PixelKind::kBayerGB || kind == PixelKind::kBayerBG;
 }
 
-// Keeps the top 8 of `bits` significant bits of little-endian 16-bit samples.
-void Narrow16To8(const std::uint8_t* src, std::size_t src_stride, int width, int height, int bits,
-                 std::uint8_t* dst, std::size_t dst_stride) {
-  const int shift = bits - 8;
-  for (int y = 0; y < height; ++y) {
-    const std::uint8_t* s = src + y * src_stride;
-    std::uint8_t* d = dst + y * dst_stride;
-    for (int x = 0; x < width; ++x) {
+// Keeps the top 8 of the format's significant bits of `raw`'s little-endian 16-bit samples, into
+// the rows of `dst` (width bytes each, no padding).
+void Narrow16To8(const RawImage& raw, std::uint8_t* dst) {
+  const int shift = raw.format.bits - 8;
+  for (int y = 0; y < raw.height; ++y) {
+    const std::uint8_t* s = raw.data + y * raw.stride_bytes;
+    std::uint8_t* d = dst + static_cast<std::size_t>(y) * raw.width;
+    for (int x = 0; x < raw.width; ++x) {
       const unsigned value =
           static_cast<unsigned>(s[2 * x]) | (static_cast<unsigned>(s[2 * x + 1]) << 8);
       const unsigned narrowed = value >> shift;
@@ -143,8 +143,7 @@ bool ConvertToGrey(const RawImage& raw, vpImage<unsigned char>* grey, std::strin
 
   if (kind == PixelKind::kMono) {
     if (wide) {
-      Narrow16To8(raw.data, raw.stride_bytes, raw.width, raw.height, raw.format.bits, grey->bitmap,
-                  raw.width);
+      Narrow16To8(raw, grey->bitmap);
     } else {
       for (int y = 0; y < raw.height; ++y) {
         std::memcpy(grey->bitmap + static_cast<std::size_t>(y) * raw.width,
@@ -164,8 +163,7 @@ bool ConvertToGrey(const RawImage& raw, vpImage<unsigned char>* grey, std::strin
       // Narrow first: the grey output has 8 bits anyway and the 8-bit demosaicing is faster.
       thread_local std::vector<std::uint8_t> narrow;
       narrow.resize(static_cast<std::size_t>(raw.width) * raw.height);
-      Narrow16To8(raw.data, raw.stride_bytes, raw.width, raw.height, raw.format.bits, narrow.data(),
-                  raw.width);
+      Narrow16To8(raw, narrow.data());
       const cv::Mat in(raw.height, raw.width, CV_8UC1, narrow.data());
       cv::cvtColor(in, out, OpenCvBayerToGrey(kind));
     } else {

@@ -1,25 +1,12 @@
 #include "tracking/head/head_kinematics.h"
 
+#include <visp3/core/vpHomogeneousMatrix.h>
 #include <visp3/robot/vpBiclops.h>
 #include <visp3/robot/vpPtu46.h>
 
+#include "models/pan_tilt.h"
+
 namespace linetrack {
-namespace {
-
-// ViSP's joint vector q = (pan, sign * tilt): vpPtu46 counts tilt upwards, vpBiclops (DH1)
-// downwards like the project.
-double ViSPTiltSign(HeadModel model) {
-  return model == HeadModel::kPtu46 ? -1.0 : 1.0;
-}
-
-vpColVector ViSPJoints(HeadModel model, double pan, double tilt) {
-  vpColVector q(2);
-  q[0] = pan;
-  q[1] = ViSPTiltSign(model) * tilt;
-  return q;
-}
-
-}  // namespace
 
 bool ParseHeadModel(const std::string& name, HeadModel* model) {
   if (name == "ptu46") {
@@ -33,61 +20,85 @@ bool ParseHeadModel(const std::string& name, HeadModel* model) {
   return false;
 }
 
+Eigen::Isometry3d AlignedMount(const Eigen::Vector3d& centre, CameraRoll roll) {
+  // Camera axes in the tilt frame: x right = -y_tilt, y down = -z_tilt, z forward = x_tilt.
+  const double sign = roll == CameraRoll::kUpright ? 1.0 : -1.0;
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.linear().col(0) = Eigen::Vector3d(0.0, -sign, 0.0);
+  mount.linear().col(1) = Eigen::Vector3d(0.0, 0.0, -sign);
+  mount.linear().col(2) = Eigen::Vector3d(1.0, 0.0, 0.0);
+  mount.translation() = centre;
+  return mount;
+}
+
+namespace {
+
+constexpr double kRotationTolerance = 1e-6;  // |R^T R - I| and |det R - 1|
+constexpr double kMaxMountOffset = 1.0;      // metres from the axes' crossing
+
+bool IsRotation(const Eigen::Matrix3d& r) {
+  return r.allFinite() &&
+         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < kRotationTolerance &&
+         std::abs(r.determinant() - 1.0) < kRotationTolerance;
+}
+
+}  // namespace
+
+bool HeadGeometry::Check(std::string* why) const {
+  if (!IsRotation(tilt_from_camera.linear()) || !tilt_from_camera.translation().allFinite()) {
+    *why = "the camera mount must be a rigid transform (finite, orthonormal rotation)";
+    return false;
+  }
+  if (!(tilt_from_camera.translation().norm() <= kMaxMountOffset)) {
+    *why = "the camera must sit within 1 m of the head's axes";
+    return false;
+  }
+  if (!IsRotation(level_from_base)) {
+    *why = "the head base's tilt must be a rotation";
+    return false;
+  }
+  return true;
+}
+
 HeadGeometry GeometryOf(HeadModel model) {
   HeadGeometry g;
   if (model == HeadModel::kPtu46) {
-    g.camera_offset = Eigen::Vector3d(0.0, vpPtu46::L, vpPtu46::h);
+    g.tilt_from_camera = AlignedMount(Eigen::Vector3d(0.0, vpPtu46::L, vpPtu46::h),  //
+                                      CameraRoll::kUpright);
   } else {
-    g.camera_offset = Eigen::Vector3d(0.0, 0.0, -static_cast<double>(vpBiclops::h));
-    g.camera_upside_down = true;
+    g.tilt_from_camera =
+        AlignedMount(Eigen::Vector3d(0.0, 0.0, -static_cast<double>(vpBiclops::h)),  //
+                     CameraRoll::kUpsideDown);
   }
   return g;
 }
 
 Eigen::Isometry3d BaseFromCamera(const HeadGeometry& geometry, double pan, double tilt) {
-  // Camera axes in the tilt frame: x right = -y_tilt, y down = -z_tilt, z forward = x_tilt.
-  Eigen::Matrix3d tilt_from_camera;
-  tilt_from_camera.col(0) = Eigen::Vector3d(0.0, -1.0, 0.0);
-  tilt_from_camera.col(1) = Eigen::Vector3d(0.0, 0.0, -1.0);
-  tilt_from_camera.col(2) = Eigen::Vector3d(1.0, 0.0, 0.0);
-  if (geometry.camera_upside_down) {
-    tilt_from_camera.col(0) *= -1.0;
-    tilt_from_camera.col(1) *= -1.0;
-  }
-  // Ry(tilt) with positive tilt looking down: rotation about +y by +tilt sends x to
-  // (cos, 0, -sin).
-  const Eigen::Matrix3d base_from_tilt = (Eigen::AngleAxisd(pan, Eigen::Vector3d::UnitZ()) *
-                                          Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()))
-                                             .toRotationMatrix();
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = base_from_tilt * tilt_from_camera;
-  pose.translation() = base_from_tilt * geometry.camera_offset;
-  return pose;
+  Eigen::Isometry3d base_from_tilt = Eigen::Isometry3d::Identity();
+  base_from_tilt.linear() = BaseFromTiltRotation(pan, tilt);
+  return base_from_tilt * geometry.tilt_from_camera;
 }
 
-HeadServoMatrices ServoMatricesOf(HeadModel model, double pan, double tilt) {
+HeadServoMatrices ServoMatricesOf(const HeadGeometry& geometry, double tilt) {
   HeadServoMatrices m;
-  vpMatrix eJe_visp;
-  const vpColVector q = ViSPJoints(model, pan, tilt);
-  if (model == HeadModel::kPtu46) {
-    const vpPtu46 ptu;
-    ptu.get_eJe(q, eJe_visp);
-    ptu.get_cVe(m.cVe);
-  } else {
-    const vpBiclops biclops;
-    biclops.get_eJe(q, eJe_visp);
-    biclops.get_cVe(m.cVe);
+  const Eigen::Isometry3d camera_from_tilt = geometry.tilt_from_camera.inverse();
+  vpHomogeneousMatrix cMe;
+  for (unsigned r = 0; r < 3; ++r) {
+    for (unsigned c = 0; c < 3; ++c)
+      cMe[r][c] = camera_from_tilt.linear()(r, c);
+    cMe[r][3] = camera_from_tilt.translation()(r);
   }
-  // d q_visp / d q_ours = diag(1, tilt sign).
-  m.eJe = eJe_visp;
-  const double s = ViSPTiltSign(model);
-  for (unsigned r = 0; r < 6; ++r)
-    m.eJe[r][1] = s * eJe_visp[r][1];
+  m.cVe.buildFrom(cMe);
+  // The pan axis (base z) seen from the tilt frame: Ry(tilt)^T z = (-sin tilt, 0, cos tilt).
+  m.eJe.resize(6, 2);  // zeroed
+  m.eJe[3][0] = -std::sin(tilt);
+  m.eJe[5][0] = std::cos(tilt);
+  m.eJe[4][1] = 1.0;
   return m;
 }
 
-Eigen::Matrix<double, 6, 2> CameraJacobian(HeadModel model, double pan, double tilt) {
-  const HeadServoMatrices m = ServoMatricesOf(model, pan, tilt);
+Eigen::Matrix<double, 6, 2> CameraJacobian(const HeadGeometry& geometry, double tilt) {
+  const HeadServoMatrices m = ServoMatricesOf(geometry, tilt);
   const vpMatrix J = static_cast<vpMatrix>(m.cVe) * m.eJe;
   Eigen::Matrix<double, 6, 2> out;
   for (int r = 0; r < 6; ++r)

@@ -1,7 +1,8 @@
 // Where a camera on a pan-tilt head looks from a robot base in the world, and the head angles that
 // look at a world point. Frames: the head's base frame has its origin where the pan and tilt axes
-// cross, x forward along the robot's heading, z up (head_kinematics.h); the camera pose on it is
-// BaseFromCamera(geometry, pan, tilt). Conventions of ../shared/docs/method.md.
+// cross, x forward along the robot's heading, z up when the base is level (head_kinematics.h);
+// the camera pose on it is BaseFromCamera(geometry, pan, tilt). Conventions of
+// docs/conventions.md.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -12,26 +13,33 @@
 namespace linetrack {
 
 // The head's base in the world: origin (x, y, crossing_height), rotated by the base heading about
-// z. `base` is the robot base's planar pose (its heading, not the camera's).
-Eigen::Isometry3d WorldFromHeadBase(const Pose3Dof& base, double crossing_height);
+// z, then tilted by geometry.level_from_base. `base` is the robot base's planar pose (its heading,
+// not the camera's).
+Eigen::Isometry3d WorldFromHeadBase(const HeadGeometry& geometry, const Pose3Dof& base,
+                                    double crossing_height);
 
 // Height of the axes' crossing that puts the camera centre `camera_height` above the floor when the
-// head is level (the camera centre rises by offset_z cos(tilt) + offset_x sin(tilt) above it).
+// head is level (pan and tilt zero): camera_height - (level_from_base t).z, t the camera centre in
+// the tilt frame.
 double CrossingHeightFor(const HeadGeometry& geometry, double camera_height);
 
 // cam_from_world of the camera on the head: (WorldFromHeadBase(base) BaseFromCamera(pan, tilt))^-1.
 Eigen::Isometry3d CamFromWorldOnHead(const HeadGeometry& geometry, const Pose3Dof& base,
                                      double crossing_height, double pan, double tilt);
 
-// The camera's pose in the matcher's terms: its centre (x, y, height) on the head, heading = base
-// heading + pan, tilt = head tilt (the paper's "tilt known but variable" case).
+// The camera's pose in the matcher's terms: its centre (x, y, height) on the head, and the heading
+// and tilt of its optical axis f (atan2(f_y, f_x), asin(-f_z)); for a camera aligned with the
+// tilt frame on a level base these are base heading + pan and the head's tilt (the paper's "tilt
+// known but variable" case). The matcher's model has no roll: a mount's roll is left out.
 RobotPose CameraPoseOnHead(const HeadGeometry& geometry, const Pose3Dof& base,
                            double crossing_height, double pan, double tilt);
 
 // Head angles that put the world point `target` on the optical axis (the image centre), pan in
-// (-pi, pi]. With the target p' in the panned frame: p'_y = offset_y fixes the pan,
-// p'_x sin(tilt) + p'_z cos(tilt) = offset_z the tilt; the solution keeps the target in front.
-// False when the target is too close to the axes for the camera offset (or offset_x != 0).
+// (-pi, pi]: Newton's method on the target's normalised image coordinates (x/z, y/z), started from
+// the closed form of a camera aligned with the tilt frame (p'_y = offset_y fixes the pan,
+// p'_x sin(tilt) + p'_z cos(tilt) = offset_z the tilt) corrected by the mount's rotation. False
+// when it finds no angles with the target in front (a target too close to the axes for the
+// camera's offset).
 bool HeadAnglesLookingAt(const HeadGeometry& geometry, const Eigen::Isometry3d& world_from_base,
                          const Eigen::Vector3d& target, double* pan, double* tilt);
 

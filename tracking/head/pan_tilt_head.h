@@ -1,5 +1,5 @@
 // One interface for pan-tilt heads: the FLIR/Directed Perception PTU driver, the simulated head.
-// Joint angles follow the project's conventions (../shared/docs/method.md): pan is counter-
+// Joint angles follow the project's conventions (docs/conventions.md): pan is counter-
 // clockwise seen from above (it adds to the robot heading), tilt is positive looking down. Both
 // are zero when the camera looks straight ahead, level. Radians, radians per second.
 #pragma once

@@ -64,19 +64,18 @@ const char* ToString(HeadCommand command) {
   return "unknown";
 }
 
-LiveLoop::LiveLoop(FrameSource* source, PanTiltHead* head, CameraPoseEstimator* estimator,
-                   BaseOdometry odometry, const WireframeModel& model,
-                   const CameraIntrinsics& camera, const LiveLoopOptions& options)
-    : source_(source),
-      head_(head),
-      estimator_(estimator),
-      odometry_(std::move(odometry)),
+LiveLoop::LiveLoop(LiveLoopParts parts, const WireframeModel& model, const CameraIntrinsics& camera,
+                   const LiveLoopOptions& options)
+    : source_(parts.source),
+      head_(parts.head),
+      estimator_(parts.estimator),
+      odometry_(std::move(parts.odometry)),
       model_(model),
       occlusion_(model),
       camera_(camera),
       options_(options),
-      geometry_(GeometryOf(options.servo.model)),
-      limits_(head->Limits()),
+      geometry_(options.servo.geometry),
+      limits_(head_->Limits()),
       servo_(options.servo),
       target_(options.target) {
   std::string why;
@@ -183,8 +182,8 @@ LiveIteration LiveLoop::Step() {
   }
   it.has_target = true;
   it.target = *target_;
-  it.servo = servo_.Compute(it.t, cam_from_world * *target_, desired_px_, camera_, it.head.pan,
-                            it.head.tilt, limits_);
+  it.servo = servo_.Compute(it.t, cam_from_world * *target_, desired_px_, camera_,
+                            HeadJoints{it.head.pan, it.head.tilt, limits_});
   if (!it.servo.ok) {
     StopHead("servo: " + it.servo.reason, &it);
   } else {

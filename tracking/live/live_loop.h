@@ -34,7 +34,7 @@ std::optional<Eigen::Vector3d> VisibleModelCentroid(const WireframeModel& model,
                                                     const CameraIntrinsics& camera);
 
 struct LiveLoopOptions {
-  HeadServoOptions servo;  // its head model is also the geometry of the camera prior
+  HeadServoOptions servo;  // its geometry is also that of the camera prior
   // The servo's target in the world (metres); empty: the centroid of the visible model in the
   // first pose, fixed from then on.
   std::optional<Eigen::Vector3d> target;
@@ -79,12 +79,20 @@ struct LiveIteration {
   double loop_ms = 0.0;  // everything after the grab: head read, estimate, servo, command
 };
 
+// What the loop runs on: the frames, the head, the pose estimate and the base's odometry (not
+// owned; they must outlive the loop).
+struct LiveLoopParts {
+  FrameSource* source = nullptr;
+  PanTiltHead* head = nullptr;
+  CameraPoseEstimator* estimator = nullptr;
+  BaseOdometry odometry;
+};
+
 class LiveLoop {
  public:
-  // Everything pointed to must outlive the loop. `camera` is the undistorted model of the
-  // frames (the poses project with it). Throws InputError on invalid options.
-  LiveLoop(FrameSource* source, PanTiltHead* head, CameraPoseEstimator* estimator,
-           BaseOdometry odometry, const WireframeModel& model, const CameraIntrinsics& camera,
+  // `model` must outlive the loop. `camera` is the undistorted model of the frames (the poses
+  // project with it). Throws InputError on invalid options.
+  LiveLoop(LiveLoopParts parts, const WireframeModel& model, const CameraIntrinsics& camera,
            const LiveLoopOptions& options);
 
   // Grabs one frame and acts on it. Returns what happened; `grab` kEndOfStream means no more.

@@ -49,10 +49,11 @@ vpImage<vpRGBa> DrawLiveOverlay(const vpImage<unsigned char>& frame, const LiveI
     }
   }
   char text[200];
-  std::snprintf(text, sizeof(text), "t %.2f s  %s (%s)  pan %.2f tilt %.2f deg  error %.1f px%s",
-                it.t, ToString(it.estimate.status), it.estimate.source.c_str(),
-                RadToDeg(it.head.pan), RadToDeg(it.head.tilt), it.servo.error_px,
-                it.servo.converged ? "  converged" : "");
+  std::snprintf(text, sizeof(text),
+                "t %.2f s  %s [%s, %s]  pan %.2f tilt %.2f deg  error %.1f px%s", it.t,
+                ToString(it.estimate.uncertainty.status), ToString(it.estimate.status),
+                it.estimate.source.c_str(), RadToDeg(it.head.pan), RadToDeg(it.head.tilt),
+                it.servo.error_px, it.servo.converged ? "  converged" : "");
   const vpFont font(14, vpFont::GENERIC_MONOSPACE);
   font.drawText(image, text, vpImagePoint(4, 4), vpColor::yellow, vpColor::black);
   return image;

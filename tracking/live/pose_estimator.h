@@ -11,6 +11,7 @@
 #include "models/robot_pose.h"
 #include "tracking/capture/frame_source.h"
 #include "tracking/head/pan_tilt_head.h"
+#include "tracking/integrity/integrity_monitor.h"
 
 namespace linetrack {
 
@@ -32,6 +33,9 @@ struct PoseEstimate {
   std::string source;  // where the pose came from ("tracker", "matcher", "simulator truth", ...)
   std::string note;    // why there is no pose (empty otherwise)
   double projection_error_deg = -1.0;  // the tracker's health when measured, else -1
+  // The pose's integrity: tracking (within the alert limits), degraded or lost, its covariance
+  // and protection levels.
+  PoseUncertainty uncertainty;
 
   bool has_pose() const { return cam_from_world.has_value(); }
 };

@@ -29,25 +29,21 @@ TrackerPoseEstimator::TrackerPoseEstimator(const WireframeModel& model, const Na
                                            const TrackerEstimatorOptions& options)
     : regions_(ViewInvariantRegions::Build(model, area)),
       settings_source_(options.settings.source) {
-  localizer_ = std::make_unique<Localizer>(model, &regions_, &area, camera, options.matcher);
-  // The tracker hands undistorted frames over: segments stay in their pixels (no camera).
-  relocalizer_ = std::make_unique<Relocalizer>(
-      *localizer_, MakeLineExtractorFunction(options.lines), options.relocalization);
-  tracker_ = std::make_unique<EdgeTracker>(model.path(), camera, options.settings);
-  sequence_ = std::make_unique<SequenceTracker>(tracker_.get(), camera, relocalizer_.get(),
-                                                options.sequence);
+  engine_ = std::make_unique<TrackingEngine>(
+      TrackingEngineModel{model.path(), &model, &regions_, &area}, camera, options);
 }
 
 TrackerPoseEstimator::~TrackerPoseEstimator() = default;
 
 PoseEstimate TrackerPoseEstimator::Estimate(const Frame& frame, const HeadState& /*head*/,
                                             const RobotPose& camera_prior) {
-  last_report_ = sequence_->Process(frame.image, frame.timestamp_s, RobotReadingOf(camera_prior));
+  last_report_ = engine_->Process(frame.image, frame.timestamp_s, RobotReadingOf(camera_prior));
   PoseEstimate estimate;
   estimate.status = PoseStatusOf(last_report_.status);
   estimate.cam_from_world = last_report_.cam_from_world;
   estimate.source = last_report_.source;
   estimate.note = last_report_.note;
+  estimate.uncertainty = last_report_.uncertainty;
   if (last_report_.health_measured) {
     estimate.projection_error_deg = last_report_.health.projection_error_deg;
   }

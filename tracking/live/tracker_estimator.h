@@ -9,16 +9,12 @@
 #include <memory>
 #include <string>
 
-#include "matching/lines/line_extractor.h"
-#include "matching/localizer.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/view_invariant_regions.h"
 #include "models/wireframe.h"
 #include "tracking/live/pose_estimator.h"
-#include "tracking/tracker/edge_tracker.h"
-#include "tracking/tracker/relocalizer.h"
-#include "tracking/tracker/sequence_tracker.h"
+#include "tracking/tracker/tracking_engine.h"
 
 namespace linetrack {
 
@@ -29,14 +25,8 @@ PoseStatus PoseStatusOf(TrackStatus status);
 // height and tilt.
 RobotReading RobotReadingOf(const RobotPose& camera_prior);
 
-// What the tracker is made of.
-struct TrackerEstimatorOptions {
-  LocalizerOptions matcher;     // the matcher for re-localisation (set for detected lines)
-  LineExtractionOptions lines;  // line extraction of the undistorted frames
-  RelocalizationOptions relocalization;
-  TrackerSettings settings;         // moving edges, visibility, passes
-  SequenceTrackerOptions sequence;  // health, motion and robot checks
-};
+// What the tracker is made of: the tracking engine's options.
+using TrackerEstimatorOptions = TrackingEngineOptions;
 
 class TrackerPoseEstimator : public CameraPoseEstimator {
  public:
@@ -54,15 +44,12 @@ class TrackerPoseEstimator : public CameraPoseEstimator {
 
   // The last frame's report (timings, health, lines).
   const FrameReport& last_report() const { return last_report_; }
-  int losses() const { return sequence_->losses(); }
-  int recoveries() const { return sequence_->recoveries(); }
+  int losses() const { return engine_->sequence().losses(); }
+  int recoveries() const { return engine_->sequence().recoveries(); }
 
  private:
   ViewInvariantRegions regions_;
-  std::unique_ptr<Localizer> localizer_;
-  std::unique_ptr<Relocalizer> relocalizer_;
-  std::unique_ptr<EdgeTracker> tracker_;
-  std::unique_ptr<SequenceTracker> sequence_;
+  std::unique_ptr<TrackingEngine> engine_;
   std::string settings_source_;
   FrameReport last_report_;
 };

@@ -13,6 +13,7 @@
 namespace linetrack {
 
 bool HeadServoOptions::Check(std::string* why) const {
+  if (!geometry.Check(why)) return false;
   if (!(gain_at_zero > 0.0 && gain_at_infinity > 0.0 && gain_at_infinity <= gain_at_zero &&
         gain_at_zero < 1e3)) {
     *why = "gains must satisfy 0 < gain at infinity <= gain at zero < 1000";
@@ -114,7 +115,9 @@ void HeadServo::Reset() {
 
 ServoStep HeadServo::Compute(double t, const Eigen::Vector3d& target_cam,
                              const Eigen::Vector2d& desired_px, const CameraIntrinsics& camera,
-                             double pan, double tilt, const HeadLimits& limits) {
+                             const HeadJoints& head) {
+  const double pan = head.pan, tilt = head.tilt;
+  const HeadLimits& limits = head.limits;
   ServoStep step;
   Impl& m = *impl_;
   if (!(target_cam.z() > 1e-6) || !target_cam.allFinite()) {
@@ -131,7 +134,7 @@ ServoStep HeadServo::Compute(double t, const Eigen::Vector3d& target_cam,
                       target_cam.z());
   m.desired.buildFrom(desired_ray.x(), desired_ray.y(), target_cam.z());
 
-  const HeadServoMatrices matrices = ServoMatricesOf(options_.model, pan, tilt);
+  const HeadServoMatrices matrices = ServoMatricesOf(options_.geometry, tilt);
   vpColVector law;
   vpMatrix jacobian, inverse;
   vpColVector feature_error;

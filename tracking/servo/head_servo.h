@@ -16,7 +16,9 @@
 namespace linetrack {
 
 struct HeadServoOptions {
-  HeadModel model = HeadModel::kPtu46;
+  // The camera on the head as the robot believes it: a head's nominal geometry (GeometryOf) or a
+  // calibrated mount. It gives the servo's cVe and eJe.
+  HeadGeometry geometry = GeometryOf(HeadModel::kPtu46);
   // vpAdaptiveGain: lambda(x) = (l0 - linf) exp(-slope x / (l0 - linf)) + linf, x = the joint
   // correction |J^+ e|_inf in radians (1/s; slope 1/(s rad)).
   double gain_at_zero = 8.0;
@@ -74,6 +76,12 @@ Eigen::Vector2d KeepWithinJointLimits(const Eigen::Vector2d& rates, double pan, 
 Eigen::Vector2d PixelError(const CameraIntrinsics& camera, const Eigen::Vector3d& target_cam,
                            const Eigen::Vector2d& desired_px);
 
+// Where the head's joints are (radians) and how far they may go.
+struct HeadJoints {
+  double pan = 0.0, tilt = 0.0;
+  HeadLimits limits;
+};
+
 // The servo. Keeps ViSP's task between iterations (hold state, target-motion estimate).
 // Not copyable (vpServo keeps pointers to its features).
 class HeadServo {
@@ -85,11 +93,10 @@ class HeadServo {
   HeadServo& operator=(const HeadServo&) = delete;
 
   // One iteration at time t (seconds): the target at `target_cam` (camera frame, from the pose),
-  // to be brought to `desired_px` of `camera` (undistorted model), the head at (pan, tilt) with
-  // `limits`. Never throws for ViSP failures (a result without command).
+  // to be brought to `desired_px` of `camera` (undistorted model), the head as `head` says.
+  // Never throws for ViSP failures (a result without command).
   ServoStep Compute(double t, const Eigen::Vector3d& target_cam, const Eigen::Vector2d& desired_px,
-                    const CameraIntrinsics& camera, double pan, double tilt,
-                    const HeadLimits& limits);
+                    const CameraIntrinsics& camera, const HeadJoints& head);
 
   // Forgets the hold state and the target-motion estimate (after a loss of tracking).
   void Reset();

@@ -6,6 +6,7 @@
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/pan_tilt.h"
 #include "models/render/sequence.h"
 #include "tracking/head/head_pointing.h"
 
@@ -25,6 +26,22 @@ double ParseNumber(const std::string& text, const std::string& key, const std::s
   } catch (const std::exception&) {
   }
   throw InputError(where + ": " + key + " needs a finite number, got '" + text + "'");
+}
+
+// Three finite numbers "A:B:C" from `text`, or an InputError naming the argument.
+Eigen::Vector3d ParseTriple(const std::string& text, const std::string& key,
+                            const std::string& where) {
+  Eigen::Vector3d v;
+  size_t begin = 0;
+  for (int k = 0; k < 3; ++k) {
+    const size_t end = k < 2 ? text.find(':', begin) : text.size();
+    if (end == std::string::npos) {
+      throw InputError(where + ": " + key + " needs three numbers A:B:C, got '" + text + "'");
+    }
+    v[k] = ParseNumber(text.substr(begin, end - begin), key, where);
+    begin = end + 1;
+  }
+  return v;
 }
 
 }  // namespace
@@ -49,6 +66,10 @@ bool SimCameraOptions::Check(std::string* why) const {
   if (!std::isfinite(still_base.x) || !std::isfinite(still_base.y) ||
       !std::isfinite(still_base.heading)) {
     *why = "the base pose must be finite";
+    return false;
+  }
+  if (!(bracket_error.head<3>().norm() < 0.1) || !(bracket_error.tail<3>().norm() < 0.5)) {
+    *why = "the bracket's error must be under 0.1 m and 0.5 rad";
     return false;
   }
   if (!std::isfinite(cap_from_s) || !std::isfinite(cap_to_s)) {
@@ -108,12 +129,17 @@ void ParseSimArguments(const std::string& arguments, SimCameraOptions* options) 
       if (!(options->cap_to_s > options->cap_from_s)) {
         throw InputError(where + ": cap must be T0-T1 with T1 > T0, got '" + value + "'");
       }
+    } else if (key == "bracket_mm") {
+      options->bracket_error.head<3>() = 1e-3 * ParseTriple(value, key, where);
+    } else if (key == "bracket_deg") {
+      options->bracket_error.tail<3>() = DegToRad(1.0) * ParseTriple(value, key, where);
     } else if (key == "render") {
       if (value != "0" && value != "1") throw InputError(where + ": render must be 0 or 1");
       options->render = value == "1";
     } else {
       throw InputError(where + ": unknown key '" + key +
-                       "' (known: path, fps, speed, seed, clutter, noise, blur, cap, render)");
+                       "' (known: path, fps, speed, seed, clutter, noise, blur, cap, render, "
+                       "bracket_mm, bracket_deg)");
     }
   }
   std::string why;
@@ -129,6 +155,7 @@ SimulatedCamera::SimulatedCamera(const WireframeModel& model, const NavigableAre
     throw InputError("simulated camera: the camera gives no image size");
   }
   geometry_ = GeometryOf(options_.head_model);
+  geometry_.tilt_from_camera = MovedPose(geometry_.tilt_from_camera, options_.bracket_error);
   crossing_height_ = CrossingHeightFor(geometry_, options_.camera_height);
   if (options_.render) {
     renderer_ = std::make_unique<SceneRenderer>(model, camera_, options_.render_options, area);
@@ -288,6 +315,17 @@ PoseEstimate SimulatorTruthEstimator::Estimate(const Frame& frame, const HeadSta
     pose = noise * pose;
   }
   estimate.cam_from_world = pose;
+  // The truth (with its stated jitter): its covariance the jitter's, its protection levels five
+  // sigmas (chi2(3) beyond 25: 1.5e-5).
+  estimate.uncertainty.status = IntegrityStatus::kTracking;
+  estimate.uncertainty.world_covariance.setZero();
+  estimate.uncertainty.world_covariance.diagonal()
+      << Eigen::Vector3d::Constant(jitter_.translation_sigma * jitter_.translation_sigma),
+      Eigen::Vector3d::Constant(jitter_.rotation_sigma * jitter_.rotation_sigma);
+  estimate.uncertainty.sigma_x_m = estimate.uncertainty.sigma_y_m = jitter_.translation_sigma;
+  estimate.uncertainty.sigma_heading_rad = jitter_.rotation_sigma;
+  estimate.uncertainty.protection_position_m = 5.0 * jitter_.translation_sigma;
+  estimate.uncertainty.protection_rotation_rad = 5.0 * jitter_.rotation_sigma;
   had_pose_ = true;
   lost_ = false;
   return estimate;

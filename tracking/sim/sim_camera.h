@@ -36,6 +36,9 @@ struct SimCameraOptions {
   Pose3Dof still_base;         // still: the base's x, y and heading (radians)
   double camera_height = 1.3;  // camera centre above the floor with the head level (metres)
   HeadModel head_model = HeadModel::kPtu46;
+  // How far the simulated bracket is off the head model's nominal mount: (shift in metres,
+  // rotation vector in radians), both in the tilt frame (MovedPose, models/pan_tilt.h).
+  Eigen::Matrix<double, 6, 1> bracket_error = Eigen::Matrix<double, 6, 1>::Zero();
   // Lens capped from cap_from_s to cap_to_s (simulated seconds): black frames, the way to force
   // a loss of tracking. Off when cap_to_s <= cap_from_s.
   double cap_from_s = 0.0, cap_to_s = 0.0;
@@ -50,7 +53,8 @@ struct SimCameraOptions {
 
 // Reads the text after "sim:" into `options` (fields not named keep their values):
 // comma-separated key=value with keys path (still|loop), fps, speed, seed, clutter, noise, blur,
-// cap (T0-T1 seconds), render (0|1). Throws InputError naming "--source sim:ARGS" and the key.
+// cap (T0-T1 seconds), render (0|1), bracket_mm (X:Y:Z shift) and bracket_deg (RX:RY:RZ rotation
+// vector) of the bracket's error. Throws InputError naming "--source sim:ARGS" and the key.
 void ParseSimArguments(const std::string& arguments, SimCameraOptions* options);
 
 // The simulated camera. Steps the simulated head attached to it: the head must outlive it and
@@ -84,6 +88,7 @@ class SimulatedCamera : public FrameSource {
   Pose3Dof OdometryAt(double t) const;
   // Height of the pan and tilt axes' crossing above the floor.
   double crossing_height() const { return crossing_height_; }
+  // The true geometry: the head model's nominal mount moved by the bracket's error.
   const HeadGeometry& geometry() const { return geometry_; }
   bool CappedAt(double t) const;
 

@@ -22,17 +22,29 @@ struct SimHeadStart {
   std::optional<Eigen::Vector2d> offset_from_target;
 };
 
+// `loop` believing the nominal geometry of the simulated head model and the crossing height that
+// geometry gives for the simulated camera's height (a height taped with the head level).
+LiveLoopOptions NominalBelief(const SimCameraOptions& camera, LiveLoopOptions loop);
+
+// The settings of the rig's parts.
+struct SimulatedLiveRigOptions {
+  SimCameraOptions camera;
+  SimulatedHeadOptions head;
+  LiveLoopOptions loop;
+  SimHeadStart start;
+  PoseJitterOptions jitter;  // of the simulator's truth, when it is the estimator
+};
+
 class SimulatedLiveRig {
  public:
   // `camera` is the camera of the frames (its undistorted model serves the loop); `model` and
-  // `area` must outlive the rig. The loop's crossing height is taken from the simulated camera.
+  // `area` must outlive the rig. The loop believes options.loop (the servo's geometry and the
+  // crossing height, e.g. NominalBelief), whatever the simulated camera's truth.
   // `estimator` gives the poses (not owned; e.g. the tracker); null: the simulator's truth,
-  // jittered by `jitter`. Throws InputError on invalid options, or when an offset start is asked
-  // without a target or the target cannot be looked at.
+  // jittered by options.jitter. Throws InputError on invalid options, or when an offset start is
+  // asked without a target or the target cannot be looked at.
   SimulatedLiveRig(const WireframeModel& model, const NavigableArea* area,
-                   const CameraIntrinsics& camera, const SimCameraOptions& camera_options,
-                   const SimulatedHeadOptions& head_options, const LiveLoopOptions& loop_options,
-                   const SimHeadStart& start = {}, const PoseJitterOptions& jitter = {},
+                   const CameraIntrinsics& camera, const SimulatedLiveRigOptions& options,
                    CameraPoseEstimator* estimator = nullptr);
 
   SimulatedCamera& camera() { return camera_; }

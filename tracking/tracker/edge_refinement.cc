@@ -33,11 +33,9 @@ bool Bilinear(const vpImage<unsigned char>& image, const Eigen::Vector2d& p, dou
   return true;
 }
 
-// A model edge as seen from the start pose: its 3D part inside the view and its image.
-struct ViewedEdge {
-  Eigen::Vector3d a, b;                 // world, clipped to the frustum
-  std::vector<Eigen::Vector2d> points;  // sub-pixel edge points attached to it
-};
+// A model edge as seen from the start pose (its 3D part inside the view, clipped to the frustum)
+// and the sub-pixel edge points attached to it.
+using ViewedEdge = EdgeObservation;
 
 // Left-multiplied update: exp([omega, v]) * pose, in the camera frame.
 Eigen::Isometry3d Update(const Eigen::Isometry3d& pose, const Eigen::Matrix<double, 6, 1>& delta) {
@@ -107,12 +105,22 @@ class PoseParameters {
   Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
 };
 
+// The unknowns of a solve, its residuals (pixels, one per edge point) and J^T W J at them.
+struct IrlsState {
+  Eigen::VectorXd p, r;
+  Eigen::MatrixXd information;
+};
+
 // Iteratively reweighted Gauss-Newton (Huber weights) on the point-to-line distances of the edge
-// points of `edges`, from the parameters `p` (updated). `r` receives the residuals at the result
-// and `information` J^T W J there. False when an edge falls behind the camera or a step fails.
+// points of `edges`, from the parameters state->p (updated, r sized to the points). state->r
+// receives the residuals at the result and state->information J^T W J there. False when an edge
+// falls behind the camera or a step fails.
 bool SolveIrls(const std::vector<ViewedEdge>& edges, const CameraIntrinsics& camera,
                const PoseParameters& parameters, const EdgeRefinementOptions& options,
-               Eigen::VectorXd* p, Eigen::VectorXd* r, Eigen::MatrixXd* information) {
+               IrlsState* state) {
+  Eigen::VectorXd* p = &state->p;
+  Eigen::VectorXd* r = &state->r;
+  Eigen::MatrixXd* information = &state->information;
   const int dof = parameters.size();
   const int n = static_cast<int>(r->size());
   Eigen::VectorXd r_step(n), w(n);
@@ -182,18 +190,21 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
 
   const PoseParameters parameters(start, known);
   const int dof = parameters.size();
-  Eigen::VectorXd r(out.points);
+  IrlsState solve;
+  Eigen::VectorXd& r = solve.r;
+  r.resize(out.points);
   if (!Residuals(used, camera, start, &r)) return out;
   out.rms_before_px = Rms(r);
 
-  Eigen::VectorXd p;
-  Eigen::MatrixXd information;
+  const Eigen::VectorXd& p = solve.p;
+  const Eigen::MatrixXd& information = solve.information;
+  std::vector<ViewedEdge> set_aside;
   for (int rejections = 0;; ++rejections) {
     const int n = PointCount(used);
     if (n < options.min_points) return out;
-    p = Eigen::VectorXd::Zero(dof);
+    solve.p = Eigen::VectorXd::Zero(dof);
     r.resize(n);
-    if (!SolveIrls(used, camera, parameters, options, &p, &r, &information)) return out;
+    if (!SolveIrls(used, camera, parameters, options, &solve)) return out;
     if (rejections == options.max_edge_rejections) break;
     const std::vector<double> means = EdgeMeanResiduals(used, r);
     int worst = -1;
@@ -206,6 +217,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
     if (worst < 0) break;
     out.rejected_points += static_cast<int>(used[worst].points.size());
     ++out.rejected_edges;
+    set_aside.push_back(std::move(used[worst]));
     used.erase(used.begin() + worst);
   }
   const Eigen::Isometry3d pose = parameters.Pose(p);
@@ -226,6 +238,8 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   out.applied = true;
   out.cam_from_world = pose;
   out.points = PointCount(used);
+  out.observations = std::move(used);
+  out.set_aside = std::move(set_aside);
   // Standard deviations from the Gauss-Newton information and the residuals' scale.
   const double scale2 = r.squaredNorm() / std::max(1, static_cast<int>(r.size()) - dof);
   const Eigen::MatrixXd covariance = scale2 * information.inverse();
@@ -320,18 +334,18 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
 
 EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
                              const std::vector<Segment3>& edges,
-                             const std::vector<Eigen::Vector2d>& sites,
-                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
-                             const std::optional<KnownHeightTilt>& known) {
+                             const std::vector<Eigen::Vector2d>& sites, const RefinementStart& from,
+                             const EdgeRefinementOptions& options) {
+  const Eigen::Isometry3d& start = from.cam_from_world;
   // The model edges in view and their images at the start pose.
   std::vector<ViewedEdge> viewed;
   std::vector<Segment2> images;
-  for (const Segment3& edge : edges) {
-    Segment3 clipped = edge;
+  for (size_t index = 0; index < edges.size(); ++index) {
+    Segment3 clipped = edges[index];
     if (!ClipToFrustum(start, camera, kNearClip, &clipped)) continue;
     const Segment2 image_edge{camera.Project(start * clipped.a), camera.Project(start * clipped.b)};
     if (image_edge.Length() < 2.0 * options.end_margin_px + 2.0) continue;
-    viewed.push_back(ViewedEdge{clipped.a, clipped.b, {}});
+    viewed.push_back(ViewedEdge{clipped.a, clipped.b, {}, static_cast<int>(index)});
     images.push_back(image_edge);
   }
   // Each site goes to the one projected edge it lies on, then to the sub-pixel step near it.
@@ -361,13 +375,14 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
         SubpixelEdgeOffset(image, site, normal, options.search_px, options.min_gradient);
     if (std::isfinite(offset)) viewed[best].points.push_back(site + offset * normal);
   }
-  return SolveOnEdgePoints(std::move(viewed), camera, start, known, options);
+  return SolveOnEdgePoints(std::move(viewed), camera, start, from.known, options);
 }
 
 EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
-                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
-                            const EdgeAlignmentOptions& options,
-                            const std::optional<KnownHeightTilt>& known) {
+                            const std::vector<Segment3>& visible, const RefinementStart& from,
+                            const EdgeAlignmentOptions& options) {
+  const Eigen::Isometry3d& start = from.cam_from_world;
+  const std::optional<KnownHeightTilt>& known = from.known;
   EdgeRefinement out;
   out.cam_from_world = start;
   Eigen::Isometry3d pose = start;
@@ -376,8 +391,8 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
     solve.search_px = round == 0 ? options.search_px : options.solve.search_px;
     solve.max_correction_px = solve.search_px;
     std::vector<ViewedEdge> viewed;
-    for (const Segment3& part : visible) {
-      Segment3 clipped = part;
+    for (size_t index = 0; index < visible.size(); ++index) {
+      Segment3 clipped = visible[index];
       if (!ClipToFrustum(pose, camera, kNearClip, &clipped)) continue;
       const Eigen::Vector2d a = camera.Project(pose * clipped.a);
       const Eigen::Vector2d b = camera.Project(pose * clipped.b);
@@ -385,7 +400,7 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
       if (length < 2.0 * solve.end_margin_px + options.sample_step_px) continue;
       const Eigen::Vector2d d = (b - a) / length;
       const Eigen::Vector2d normal(-d.y(), d.x());
-      ViewedEdge edge{clipped.a, clipped.b, {}};
+      ViewedEdge edge{clipped.a, clipped.b, {}, static_cast<int>(index)};
       for (double s = solve.end_margin_px; s <= length - solve.end_margin_px;
            s += options.sample_step_px) {
         const Eigen::Vector2d p = a + s * d;
@@ -401,6 +416,8 @@ EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraInt
     pose = step.cam_from_world;
     out.points = step.points;
     out.rms_after_px = step.rms_after_px;
+    out.observations = step.observations;
+    out.set_aside = step.set_aside;
   }
   out.applied = true;
   out.cam_from_world = pose;

@@ -44,10 +44,19 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
                           const Eigen::Vector2d& normal, double search_px, double min_gradient);
 
 // A robot camera's known height (metres) and tilt (radians): with it the refinement estimates
-// x, y and heading only, with zero roll (conventions of method.md).
+// x, y and heading only, with zero roll (docs/conventions.md).
 struct KnownHeightTilt {
   double height = 0.0;
   double tilt = 0.0;
+};
+
+// One model edge and the sub-pixel edge points the refinement attached to it: the measurements
+// of the pose (tracking/integrity/ computes the pose's covariance and integrity from them).
+struct EdgeObservation {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // world (metres): the edge's part in view
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector2d> points;  // undistorted pixels
+  int model_edge = -1;                  // index of the edge in the refinement's input
 };
 
 // The outcome of RefineOnEdges.
@@ -63,17 +72,25 @@ struct EdgeRefinement {
   // metres) and heading (radians), from the Gauss-Newton information and the residuals' scale.
   double position_sigma_m = 0.0;
   double heading_sigma_rad = 0.0;
+  // When applied: the edges and points of the final solve, and the edges set aside.
+  std::vector<EdgeObservation> observations;
+  std::vector<EdgeObservation> set_aside;
 };
 
-// Refines `start` (cam_from_world) so that the model `edges` (world) pass through the sub-pixel
-// edge points found near `sites` (pixels of the undistorted `image`, e.g. ViSP's good moving
-// edges). `camera` is the undistorted camera. With `known`, the result has that height and tilt
-// and zero roll.
+// Where a refinement starts: a pose and, for a robot, its known height and tilt (the result then
+// keeps them, with zero roll).
+struct RefinementStart {
+  Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
+  std::optional<KnownHeightTilt> known;
+};
+
+// Refines start.cam_from_world so that the model `edges` (world) pass through the sub-pixel edge
+// points found near `sites` (pixels of the undistorted `image`, e.g. ViSP's good moving edges).
+// `camera` is the undistorted camera.
 EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
                              const std::vector<Segment3>& edges,
                              const std::vector<Eigen::Vector2d>& sites,
-                             const Eigen::Isometry3d& start, const EdgeRefinementOptions& options,
-                             const std::optional<KnownHeightTilt>& known = std::nullopt);
+                             const RefinementStart& start, const EdgeRefinementOptions& options);
 
 // Coarse alignment of a predicted pose (e.g. from the robot's odometry) before the moving edges
 // take over: edge points are searched along the normals of the projected visible model edges,
@@ -81,19 +98,18 @@ EdgeRefinement RefineOnEdges(const vpImage<unsigned char>& image, const CameraIn
 // Gauss-Newton refinement.
 struct EdgeAlignmentOptions {
   double sample_step_px = 6.0;  // distance between searches along a projected edge
-  double search_px = 12.0;      // first round's half search length
+  double search_px = 12.0;      // the first search pass: half its length
   int rounds = 2;
   EdgeRefinementOptions solve;  // later rounds search solve.search_px
 
   bool Check(std::string* why) const;
 };
 
-// Aligns `start` on the image edges near the projections of `visible` (the visible parts of the
-// model edges at `start`, world). `applied` is false when a round finds too few points or does
-// not improve.
+// Aligns start.cam_from_world on the image edges near the projections of `visible` (the visible
+// parts of the model edges at that pose, world). `applied` is false when a round finds too few
+// points or does not improve.
 EdgeRefinement AlignToEdges(const vpImage<unsigned char>& image, const CameraIntrinsics& camera,
-                            const std::vector<Segment3>& visible, const Eigen::Isometry3d& start,
-                            const EdgeAlignmentOptions& options,
-                            const std::optional<KnownHeightTilt>& known = std::nullopt);
+                            const std::vector<Segment3>& visible, const RefinementStart& start,
+                            const EdgeAlignmentOptions& options);
 
 }  // namespace linetrack

@@ -12,6 +12,13 @@
 #include <limits>
 #include <sstream>
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+
+#include "models/cao_reader.h"
+#include "models/cao_writer.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/wireframe.h"
@@ -78,10 +85,38 @@ void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker) {
   }
   try {
     ScopedStdoutSilencer silence;
-    tracker->loadModel(model_path, false);
+    tracker->loadModel(model_path, /*verbose=*/false);
   } catch (const vpException& e) {
     throw InputError(
         Located(model_path, 0, std::string("ViSP cannot load the model: ") + e.getMessage()));
+  }
+}
+
+void LoadOrientedVispModel(const CaoModel& cao, const WireframeModel& model,
+                           vpMbGenericTracker* tracker) {
+  if (!model.oriented()) {
+    LoadVispModel(model.path(), tracker);
+    return;
+  }
+  // ViSP reads models from files only: a private temporary file, removed once read.
+  std::string path =
+      (std::filesystem::temp_directory_path() / "linetrack-oriented-XXXXXX.cao").string();
+  const int fd = mkstemps(path.data(), 4);
+  if (fd < 0)
+    throw InputError(Located(model.path(), 0, "cannot write the oriented model for ViSP"));
+  close(fd);
+  struct Remove {
+    std::string path;
+    ~Remove() {
+      std::error_code ec;
+      std::filesystem::remove(path, ec);
+    }
+  } remove{path};
+  std::ofstream(path) << CaoText(OrientedCao(cao, model), model.path() + ", faces oriented");
+  try {
+    LoadVispModel(path, tracker);
+  } catch (const InputError& e) {
+    throw InputError(Located(model.path(), 0, std::string("oriented copy: ") + e.what()));
   }
 }
 
@@ -125,8 +160,9 @@ EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& 
   if (camera_.width <= 0 || camera_.height <= 0) {
     throw InputError("camera '" + camera_.name + "': the image size is needed to track");
   }
-  LoadVispModel(model_path, tracker_.get());
-  model_ = std::make_unique<WireframeModel>(WireframeModel::Load(model_path));
+  const CaoModel cao = ReadCao(model_path);
+  model_ = std::make_unique<WireframeModel>(WireframeModel::FromCao(cao));
+  LoadOrientedVispModel(cao, *model_, tracker_.get());
   occlusion_ = std::make_unique<OcclusionTester>(*model_);
   for (const ModelEdge& edge : model_->edges())
     edges_.push_back(edge.segment);
@@ -150,7 +186,7 @@ EdgeTrackResult EdgeTracker::Start(const vpImage<unsigned char>& image,
     result.cam_from_world = FromVispPose(tracker_->getPose());
     started_ = true;
   } catch (const vpException& e) {
-    result.reason = std::string("ViSP: ") + e.getMessage();
+    result.reason = TrackingFailureReason(e.getMessage());
   }
   return result;
 }
@@ -162,7 +198,7 @@ EdgeTrackResult EdgeTracker::StartFromPrediction(const vpImage<unsigned char>& i
   for (const ProjectedEdge& edge : ProjectVisibleEdges(*model_, *occlusion_, predicted, camera_))
     visible.push_back(edge.world);
   const EdgeRefinement aligned =
-      AlignToEdges(image, camera_, visible, predicted, settings_.alignment, known);
+      AlignToEdges(image, camera_, visible, {predicted, known}, settings_.alignment);
   if (!aligned.applied) {
     started_ = false;
     EdgeTrackResult result;
@@ -202,7 +238,7 @@ EdgeTrackResult EdgeTracker::Track(const vpImage<unsigned char>& image, bool wit
     return measured;
   } catch (const vpException& e) {
     started_ = false;
-    result.reason = std::string("ViSP: ") + e.getMessage();
+    result.reason = TrackingFailureReason(e.getMessage());
     return result;
   }
 }
@@ -219,8 +255,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
   health.edges_total = sites.total;
   health.edges_good = static_cast<int>(sites.good.size());
   if (settings_.refine_subpixel) {
-    const EdgeRefinement refined = RefineOnEdges(
-        image, camera_, edges_, sites.good, result.cam_from_world, settings_.refinement, known);
+    EdgeRefinement refined = RefineOnEdges(image, camera_, edges_, sites.good,
+                                           {result.cam_from_world, known}, settings_.refinement);
     health.refined = refined.applied;
     health.refined_points = refined.points;
     if (refined.applied) {
@@ -230,6 +266,8 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       health.refined_rejected_edges = refined.rejected_edges;
       health.refined_position_sigma_m = refined.position_sigma_m;
       health.refined_heading_sigma_deg = RadToDeg(refined.heading_sigma_rad);
+      result.observations = std::move(refined.observations);
+      result.set_aside = std::move(refined.set_aside);
     }
   }
   if (!with_covariance) return result;
@@ -245,6 +283,23 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
     health.rotation_sigma_deg = vpMath::deg(sigmas.y());
   }
   return result;
+}
+
+std::string TrackingFailureReason(const std::string& visp_message) {
+  if (visp_message.rfind("Not enough moving edges", 0) != 0) return "ViSP: " + visp_message;
+  // "Not enough moving edges (N) to track the object: expected M. Try to reduce ..." (or
+  // without the counts): N good moving edges, M needed.
+  std::string counts;
+  const size_t open = visp_message.find('('), expected = visp_message.find("expected ");
+  if (open != std::string::npos && expected != std::string::npos) {
+    const std::string found = visp_message.substr(open + 1, visp_message.find(')') - open - 1);
+    const size_t end = visp_message.find_first_not_of("0123456789", expected + 9);
+    counts = " (" + found + " where " + visp_message.substr(expected + 9, end - expected - 9) +
+             " were needed)";
+  }
+  return "too few moving edges found the model's edges in the image" + counts +
+         ": the pose is off or the edges are faint; a larger <ecm><range><tracking> or a lower "
+         "<ecm><contrast><edge_threshold> in the tracker settings file finds more";
 }
 
 }  // namespace linetrack

@@ -26,7 +26,7 @@ namespace linetrack {
 // The outcome of Start() or Track().
 struct EdgeTrackResult {
   bool ok = false;     // false: ViSP failed (reason says why); the pose is then meaningless
-  std::string reason;  // ViSP's message when !ok
+  std::string reason;  // why ViSP failed when !ok (TrackingFailureReason)
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // cMo after the call
   // ViSP's own pose before the sub-pixel refinement (equal to cam_from_world without it).
   Eigen::Isometry3d visp_cam_from_world = Eigen::Isometry3d::Identity();
@@ -34,6 +34,10 @@ struct EdgeTrackResult {
   double passes_ms = 0.0;   // Track(): wall clock in ViSP's track() calls
   double measure_ms = 0.0;  // Track(): projection error read, moving-edge states, refinement,
                             // covariance
+  // Track() with the sub-pixel refinement applied: its edges and points (the measurements of the
+  // pose, for tracking/integrity/) and the edges it set aside.
+  std::vector<EdgeObservation> observations;
+  std::vector<EdgeObservation> set_aside;
 };
 
 // RMS image motion (pixels) of the model `edges` (world) between two poses: the edges are clipped
@@ -44,10 +48,10 @@ double RmsImageMotionPx(const std::vector<Segment3>& edges, const CameraIntrinsi
 
 class EdgeTracker {
  public:
-  // Loads the .cao model through ViSP (and linetrack's reader, for the edges the sub-pixel
-  // refinement uses) and applies `settings` and the (undistorted) camera, whose image size must
-  // be known. Throws InputError naming the model when it cannot be loaded, or naming the settings'
-  // source when they are invalid.
+  // Reads the .cao model (linetrack's reader orients its faces), hands ViSP the oriented model
+  // (LoadOrientedVispModel) and applies `settings` and the (undistorted) camera, whose image size
+  // must be known. Throws InputError naming the model when it cannot be loaded, or naming the
+  // settings' source when they are invalid.
   EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
               const TrackerSettings& settings);
   ~EdgeTracker();
@@ -116,5 +120,17 @@ void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsic
 // Loads a .cao model into a ViSP tracker without ViSP's console output. Throws InputError naming
 // the file when ViSP cannot load it.
 void LoadVispModel(const std::string& model_path, vpMbGenericTracker* tracker);
+
+// Loads `model` (built from `cao`) into a ViSP tracker with its faces as linetrack oriented them
+// (through a temporary .cao file, models/cao_writer.h); an object left as written loads from its
+// own file. Throws InputError naming the model when ViSP cannot load it.
+void LoadOrientedVispModel(const CaoModel& cao, const WireframeModel& model,
+                           vpMbGenericTracker* tracker);
+
+// Why ViSP's tracker failed, in the user's terms. ViSP's "not enough moving edges ... Try to reduce
+// the threshold=R using setGoodMovingEdgesRatioThreshold()" names an API call; this says what
+// failed and which keys of the tracker settings file find more moving edges. Other messages
+// come back as "ViSP: message".
+std::string TrackingFailureReason(const std::string& visp_message);
 
 }  // namespace linetrack

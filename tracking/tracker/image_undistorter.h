@@ -1,7 +1,7 @@
 // Undistortion of grey frames before tracking (ViSP's tracker expects undistorted images), with
 // a map precomputed once per camera, so a frame costs one bilinear remap (OpenCV's fixed-point
-// cv::remap: 0.5 ms at 640x480 here, where vpImageTools::undistort, which copies its maps on every
-// call, took 9 ms). Without distortion the frame is passed through untouched.
+// cv::remap; vpImageTools::undistort copies its maps on every call, docs/tracking.md). Without
+// distortion the frame is passed through untouched.
 #pragma once
 
 #include <visp3/core/vpImage.h>

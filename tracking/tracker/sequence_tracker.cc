@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "models/errors.h"
@@ -26,7 +27,43 @@ RobotPose WithReading(const Pose3Dof& planar, const RobotReading& robot) {
   return RobotPose{planar.x, planar.y, planar.heading, robot.height, robot.tilt};
 }
 
+Pose3Dof PlanarOf(const Eigen::Isometry3d& cam_from_world) {
+  return RobotPoseFromCamFromWorld(cam_from_world).Planar();
+}
+
+// Where the odometry carries `pose` from the reading `then` to `now` (both with odometry).
+Pose3Dof Carry(const Pose3Dof& pose, const RobotReading& then, const RobotReading& now) {
+  return CarryPrior(WithReading(pose, now), WithReading(*then.odometry, then),
+                    WithReading(*now.odometry, now))
+      .Planar();
+}
+
+// Position (metres) and heading (radians, wrapped) differences of two planar poses.
+Eigen::Vector2d PlanarDifference(const Pose3Dof& a, const Pose3Dof& b) {
+  return {std::hypot(a.x - b.x, a.y - b.y),
+          std::abs(std::remainder(a.heading - b.heading, 2.0 * kPi))};
+}
+
+std::string Fixed(double value, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
 }  // namespace
+
+bool ReacquisitionCheck::Check(std::string* why) const {
+  if (confirm_frames < 0 || !(allowance_m >= 0.0) || !(drift_share >= 0.0) ||
+      !(heading_allowance_rad >= 0.0) || !(confirm_distance_m >= 0.0)) {
+    *why = "reacquisition: frames, allowances, drift share and distance must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+double ReacquisitionAllowanceM(const ReacquisitionCheck& check, double driven_m) {
+  return check.allowance_m + check.drift_share * driven_m;
+}
 
 const char* ToString(TrackStatus status) {
   switch (status) {
@@ -52,6 +89,7 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
   tolerances.height = 0.0;
   tolerances.tilt = 0.0;
   if (!health.Check(why) || !motion.Check(why) || !tolerances.Check(why)) return false;
+  if (!integrity.Check(why) || !reacquisition.Check(why)) return false;
   if (restart_window < 0) {
     *why = "restart window must be >= 0 frames";
     return false;
@@ -133,7 +171,7 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
                              const std::optional<RobotReading>& robot, const char* source,
                              FrameReport* report) {
   following_ = true;
-  last_good_ = GoodPose{result.cam_from_world, t, robot};
+  last_good_ = GoodPose{result.cam_from_world, t, robot, driven_m_};
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
     recent_projection_errors_.pop_front();
@@ -166,7 +204,112 @@ bool SequenceTracker::StartAndVerify(const Eigen::Isometry3d& candidate, double 
   }
   following_ = true;
   report->cam_from_world = result.cam_from_world;
+  verified_observations_ = result.observations;
   return true;
+}
+
+void SequenceTracker::Assess(const std::vector<EdgeObservation>& observations,
+                             const std::optional<RobotReading>& robot, FrameReport* report) {
+  PoseUncertainty& u = report->uncertainty;
+  if (observations.empty()) {
+    u = PoseUncertainty();
+    u.status = IntegrityStatus::kDegraded;
+    u.reason = "no edge points bound the pose (sub-pixel refinement not applied)";
+    return;
+  }
+  // The tracker's pose is reported (it is the one the next frame starts from); the levels bound
+  // its error.
+  IntegrityOptions options = options_.integrity;
+  options.bound_start_pose = true;
+  const PoseIntegrity integrity =
+      EvaluatePoseIntegrity(observations, tracker_->camera(), *report->cam_from_world,
+                            PoseParameterisation(Known(robot)), options);
+  u = UncertaintyOf(integrity);
+  if (integrity.status == IntegrityStatus::kLost) report->cam_from_world.reset();
+}
+
+bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robot,
+                                         const std::optional<GoodPose>* started_after,
+                                         FrameReport* report) {
+  if (!report->cam_from_world) return true;  // lost to the integrity monitor: nothing to check
+  const ReacquisitionCheck& check = options_.reacquisition;
+  PoseUncertainty& u = report->uncertainty;
+  const Pose3Dof pose = PlanarOf(*report->cam_from_world);
+  const bool odometry = robot && robot->odometry;
+  const double sigma = u.has_covariance() ? 3.0 * std::max(u.sigma_x_m, u.sigma_y_m) : 0.0;
+  if (started_after || !reacquisition_) {
+    Reacquisition r;
+    r.pose = pose;
+    r.robot = robot;
+    r.driven_at_start_m = driven_m_;
+    if (started_after) r.before = *started_after;
+    const GoodPose* before = r.before ? &*r.before : nullptr;
+    if (before && odometry && before->robot && before->robot->odometry) {
+      const Eigen::Vector2d d =
+          PlanarDifference(pose, Carry(PlanarOf(before->cam_from_world), *before->robot, *robot));
+      const double driven = driven_m_ - before->driven_m;
+      const double allowance = ReacquisitionAllowanceM(check, driven) + sigma;
+      r.jump_m = d[0];
+      if (d[0] > allowance || d[1] > check.heading_allowance_rad + check.drift_share * driven) {
+        r.jump = Fixed(d[0], 2) + " m / " + Fixed(RadToDeg(d[1]), 1) +
+                 " deg from where the odometry carries the last good pose (allowance " +
+                 Fixed(allowance, 2) + " m)";
+        r.needed_m = check.confirm_distance_m;
+      }
+    }
+    reacquisition_ = r;
+  } else {
+    Reacquisition& r = *reacquisition_;
+    ++r.frames;
+    if (odometry && r.robot && r.robot->odometry) {
+      const Eigen::Vector2d d = PlanarDifference(pose, Carry(r.pose, *r.robot, *robot));
+      const double driven = driven_m_ - r.driven_at_start_m;
+      const double allowance = ReacquisitionAllowanceM(check, driven) + sigma;
+      if (d[0] > allowance || d[1] > check.heading_allowance_rad + check.drift_share * driven) {
+        report->note = "the re-localised pose moved " + Fixed(d[0], 2) + " m / " +
+                       Fixed(RadToDeg(d[1]), 1) + " deg away from the odometry's motion";
+        return false;
+      }
+    }
+  }
+  const Reacquisition& r = *reacquisition_;
+  const double driven = driven_m_ - r.driven_at_start_m;
+  if (r.frames >= check.confirm_frames && driven >= r.needed_m) {
+    reacquisition_.reset();
+    return true;
+  }
+  std::string why = "re-localisation being confirmed: " + std::to_string(r.frames) + " of " +
+                    std::to_string(check.confirm_frames) + " frames";
+  if (!r.jump.empty()) {
+    why += ", " + Fixed(driven, 1) + " of " + Fixed(r.needed_m, 1) + " m; " + r.jump;
+    // Either the matcher's pose or the one the odometry carries may be right: the covariance
+    // spans both.
+    if (u.has_covariance()) {
+      u.world_covariance(0, 0) += r.jump_m * r.jump_m;
+      u.world_covariance(1, 1) += r.jump_m * r.jump_m;
+      u.sigma_x_m = std::sqrt(u.world_covariance(0, 0));
+      u.sigma_y_m = std::sqrt(u.world_covariance(1, 1));
+      u.protection_position_m += r.jump_m;
+    }
+  }
+  if (u.status == IntegrityStatus::kTracking) u.status = IntegrityStatus::kDegraded;
+  u.reason = u.reason.empty() ? why : why + "; " + u.reason;
+  return true;
+}
+
+void SequenceTracker::Drop(const std::string& why, FrameReport* report) {
+  following_ = false;
+  ++losses_;
+  if (reacquisition_ && reacquisition_->before) {
+    last_good_ = reacquisition_->before;
+    last_good_index_ = frame_index_;
+  }
+  reacquisition_.reset();
+  report->status = TrackStatus::kLost;
+  report->note = why;
+  report->cam_from_world.reset();
+  report->uncertainty = PoseUncertainty();
+  report->uncertainty.reason = why;
 }
 
 bool SequenceTracker::MatcherPrior(const RobotReading& robot, RobotPose* prior,
@@ -213,34 +356,50 @@ void SequenceTracker::MaybePredict(const std::optional<RobotReading>& robot, Fra
   report->predicted = true;
 }
 
+void SequenceTracker::Follow(double t, const std::optional<RobotReading>& robot,
+                             FrameReport* report) {
+  const Clock::time_point track_start = Clock::now();
+  MaybePredict(robot, report);
+  report->predict_ms = MillisecondsSince(track_start);
+  const EdgeTrackResult result =
+      tracker_->Track(*undistorted_, /*with_covariance=*/false, Known(robot));
+  report->track_ms = MillisecondsSince(track_start);
+  report->passes_ms = result.passes_ms;
+  report->measure_ms = result.measure_ms;
+  report->health = result.health;
+  report->health_measured = result.ok;
+  const std::string problem = Judge(result, t, robot);
+  if (!problem.empty()) {
+    following_ = false;
+    ++losses_;
+    report->status = TrackStatus::kLost;
+    report->note = problem;
+    report->uncertainty.reason = problem;
+    return;
+  }
+  Accept(result, t, robot, "tracker", report);
+  report->status = TrackStatus::kTracking;
+  Assess(result.observations, robot, report);
+  if (reacquisition_ && !CheckReacquisition(robot, nullptr, report)) Drop(report->note, report);
+}
+
 FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double t,
                                      const std::optional<RobotReading>& robot) {
   const Clock::time_point start = Clock::now();
   ++frame_index_;
+  if (robot && robot->odometry) {
+    if (last_odometry_) {
+      driven_m_ += std::hypot(robot->odometry->x - last_odometry_->x,
+                              robot->odometry->y - last_odometry_->y);
+    }
+    last_odometry_ = robot->odometry;
+  }
   FrameReport report;
   undistorted_ = &undistorter_.Apply(image);
   report.undistort_ms = MillisecondsSince(start);
 
   if (following_) {
-    const Clock::time_point track_start = Clock::now();
-    MaybePredict(robot, &report);
-    report.predict_ms = MillisecondsSince(track_start);
-    const EdgeTrackResult result = tracker_->Track(*undistorted_, false, Known(robot));
-    report.track_ms = MillisecondsSince(track_start);
-    report.passes_ms = result.passes_ms;
-    report.measure_ms = result.measure_ms;
-    report.health = result.health;
-    report.health_measured = result.ok;
-    const std::string problem = Judge(result, t, robot);
-    if (problem.empty()) {
-      Accept(result, t, robot, "tracker", &report);
-      report.status = TrackStatus::kTracking;
-    } else {
-      following_ = false;
-      ++losses_;
-      report.status = TrackStatus::kLost;
-      report.note = problem;
-    }
+    Follow(t, robot, &report);
     report.total_ms = MillisecondsSince(start);
     return report;
   }
@@ -287,12 +446,21 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     accepted.ok = true;
     accepted.cam_from_world = pose;
     accepted.health = report.health;
+    std::optional<GoodPose> before = last_good_;
+    if (reacquisition_ && reacquisition_->before) before = reacquisition_->before;
     Accept(accepted, t, robot, source, &report);
     report.status = had_pose ? TrackStatus::kRelocalised : TrackStatus::kTracking;
     if (had_pose) ++recoveries_;
+    Assess(verified_observations_, robot, &report);
+    const bool matcher = std::string(source) == "matcher";
+    if ((matcher || reacquisition_) &&
+        !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
+      Drop(report.note, &report);
+    }
   } else {
     report.status = had_pose ? TrackStatus::kLost : TrackStatus::kInitialising;
     report.cam_from_world.reset();
+    report.uncertainty.reason = report.note;
   }
   report.total_ms = MillisecondsSince(start);
   return report;

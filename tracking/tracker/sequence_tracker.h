@@ -13,6 +13,7 @@
 #include <string>
 
 #include "models/robot_pose.h"
+#include "tracking/integrity/integrity_monitor.h"
 #include "tracking/tracker/edge_tracker.h"
 #include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/relocalizer.h"
@@ -39,7 +40,30 @@ struct RobotReading {
   double tilt = 0.0;    // radians, positive down
 };
 
+// A pose found by the matcher (the first one or after a loss) is reported degraded until it is
+// confirmed: tracked over confirm_frames frames, its motion agreeing with the odometry's; with a
+// good pose before the loss, it must also lie where the odometry carries that pose, within
+// allowance_m + drift_share x the distance driven since, else it is confirmed only after
+// confirm_distance_m more of consistent driving. A tracked pose whose motion since the matcher's
+// pose departs from the odometry's by more than the allowance (and 3 sigma) is dropped.
+struct ReacquisitionCheck {
+  int confirm_frames = 5;
+  double allowance_m = 0.10;
+  double drift_share = 0.03;  // odometry drift per metre driven
+  double heading_allowance_rad = 5.0 * kPi / 180.0;
+  double confirm_distance_m = 2.0;
+
+  bool Check(std::string* why) const;
+};
+
+// The reacquisition allowance (metres) after `driven_m` metres: allowance_m + drift_share driven.
+double ReacquisitionAllowanceM(const ReacquisitionCheck& check, double driven_m);
+
 struct SequenceTrackerOptions {
+  // Each pose's covariance, protection levels and status (tracking, degraded, lost) from the
+  // refinement's edges and points (tracking/integrity/, docs/integrity.md).
+  IntegrityOptions integrity;
+  ReacquisitionCheck reacquisition;
   HealthThresholds health;
   MotionLimits motion;
   RobotConstraint robot_tolerances;  // its height and tilt are replaced by each frame's reading
@@ -52,21 +76,20 @@ struct SequenceTrackerOptions {
   // aligned on the image edges before tracking when that motion moves the model's image by more
   // than prediction_min_px (RMS over the model edges in view, RmsImageMotionPx).
   double prediction_min_px = 3.0;
-  // A jump of the projection error to more than jump_ratio times its median over the last
-  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
-  // (e.g. a door casing beside the modelled edge): the pose is dropped.
   // A robot's pose must be confirmed by the sub-pixel refinement on the edges (with its height
   // and tilt); otherwise ViSP's unconstrained pose would be reported.
   bool robot_requires_refinement = true;
+  // A jump of the projection error to more than jump_ratio times its median over the last
+  // jump_window good frames (and above jump_floor_deg) means the edges latched onto other lines
+  // (e.g. a door casing beside the modelled edge): the pose is dropped.
   double jump_ratio = 3.0;
   double jump_floor_deg = 8.0;
   int jump_window = 15;
   // Likewise, for a robot, the sub-pixel refinement's residual (rms_after): the model edges
   // fitting the image edges more than rms_jump_ratio times worse than over the last jump_window
   // good frames (and worse than rms_jump_floor_px) means some latched onto unmodelled lines and
-  // pulled the pose (hall at 30 frames/s: 0.53 px after 0.20, 6.6 cm off). A ratio of 2 also
-  // catches the bench servo drive's 5-9 cm poses (0.30-0.50 px after 0.13-0.19) but drops good
-  // poses of the live drive test (0.34-0.42 px after 0.16-0.19): docs/tracking.md.
+  // pulled the pose while ViSP's own checks pass. A lower ratio refuses smaller pulls but also
+  // good poses whose residual merely fluctuates (the trade-off: docs/tracking.md, health).
   double rms_jump_ratio = 2.5;
   double rms_jump_floor_px = 0.3;
 
@@ -82,8 +105,13 @@ Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const Robot
 // What happened on one frame.
 struct FrameReport {
   TrackStatus status = TrackStatus::kInitialising;
-  std::optional<Eigen::Isometry3d> cam_from_world;  // only for kTracking and kRelocalised
-  TrackHealth health;                               // of the last tracking on this frame
+  // The pose (the integrity monitor's when it has one): only for kTracking and kRelocalised, and
+  // not when the integrity monitor finds the pose lost.
+  std::optional<Eigen::Isometry3d> cam_from_world;
+  // What may be done with the pose: tracking (within the alert limits), degraded, lost (no pose);
+  // its covariance and protection levels.
+  PoseUncertainty uncertainty;
+  TrackHealth health;  // of the last tracking on this frame
   bool health_measured = false;
   std::string source;  // where the pose came from: "tracker", "start pose", "matcher", "restart"
   std::string note;    // why there is no pose (empty otherwise)
@@ -120,13 +148,18 @@ class SequenceTracker {
   const vpImage<unsigned char>& undistorted() const { return *undistorted_; }
   EdgeTracker& tracker() { return *tracker_; }
   int losses() const { return losses_; }
+  const SequenceTrackerOptions& options() const { return options_; }
   int recoveries() const { return recoveries_; }
+  // A matcher's pose is being confirmed (ReacquisitionCheck): its poses are reported degraded
+  // until it is.
+  bool reacquiring() const { return reacquisition_.has_value(); }
 
  private:
   struct GoodPose {
     Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
     double t = 0.0;
     std::optional<RobotReading> robot;  // what the robot read at that frame
+    double driven_m = 0.0;              // odometry distance driven until that frame
   };
 
   // Empty when the tracked result can be kept at time t, else why not.
@@ -143,6 +176,30 @@ class SequenceTracker {
   void MaybePredict(const std::optional<RobotReading>& robot, FrameReport* report);
   void Accept(const EdgeTrackResult& result, double t, const std::optional<RobotReading>& robot,
               const char* source, FrameReport* report);
+  // Tracks the frame from the previous pose and judges the result (lost when it fails).
+  void Follow(double t, const std::optional<RobotReading>& robot, FrameReport* report);
+  // The pose's covariance, protection levels and status from its edge points (the reported pose
+  // becomes the monitor's); then the reacquisition check of a matcher's pose.
+  void Assess(const std::vector<EdgeObservation>& observations,
+              const std::optional<RobotReading>& robot, FrameReport* report);
+  // Starts (a matcher's pose; `started_after` points to the good pose before it) or continues the
+  // reacquisition check; false when the tracked motion departs from the odometry's.
+  bool CheckReacquisition(const std::optional<RobotReading>& robot,
+                          const std::optional<GoodPose>* started_after, FrameReport* report);
+  void Drop(const std::string& why, FrameReport* report);
+
+  // A matcher's pose being confirmed: the pose and the robot's reading at that frame, the frames
+  // tracked since, and the good pose before it (restored when the check fails).
+  struct Reacquisition {
+    Pose3Dof pose;
+    std::optional<RobotReading> robot;
+    double driven_at_start_m = 0.0;
+    int frames = 0;
+    double needed_m = 0.0;  // distance to drive before confirmation
+    double jump_m = 0.0;    // distance from where the odometry carries the good pose before
+    std::string jump;       // that disagreement in words, when beyond the allowance
+    std::optional<GoodPose> before;
+  };
 
   EdgeTracker* tracker_;
   ImageUndistorter undistorter_;
@@ -154,10 +211,14 @@ class SequenceTracker {
   std::optional<Eigen::Isometry3d> start_pose_;
   std::optional<Pose3Dof> initial_prior_;
   std::optional<GoodPose> last_good_;
-  std::deque<double> recent_projection_errors_;  // of the last good frames
-  std::deque<double> recent_refined_rms_;        // refinement residuals of the last good frames
-  bool following_ = false;  // the tracker holds a good pose from the previous frame
-  long frame_index_ = -1;   // frames processed - 1
+  std::optional<Reacquisition> reacquisition_;
+  std::optional<Pose3Dof> last_odometry_;
+  double driven_m_ = 0.0;  // odometry distance driven since the first frame
+  std::vector<EdgeObservation> verified_observations_;  // of the last StartAndVerify
+  std::deque<double> recent_projection_errors_;         // of the last good frames
+  std::deque<double> recent_refined_rms_;  // refinement residuals of the last good frames
+  bool following_ = false;                 // the tracker holds a good pose from the previous frame
+  long frame_index_ = -1;                  // frames processed - 1
   long last_good_index_ = -1;
   int losses_ = 0;
   int recoveries_ = 0;

@@ -40,9 +40,9 @@ struct TrackerSettings {
   MovingEdgeSettings me;
   VisibilitySettings visibility;
   // Tracking passes per frame: each pass searches the moving edges again from the pose found by
-  // the previous one, sampling them every pass_step_factor * sample_step pixels. Three passes at
-  // half density hold the pose on Castle-simu and on the end of mbt/cube, where one pass (ViSP's
-  // own track()) drifts; they cost about 1.6x one ViSP track() (docs/tracking.md).
+  // the previous one, sampling them every pass_step_factor * sample_step pixels. Several passes
+  // at lower density hold the pose where one pass at full density (ViSP's own track()) loses it,
+  // for a little more time (docs/tracking.md, moving edges).
   int passes = 2;
   double pass_step_factor = 2.0;
   // Sub-pixel refinement of each tracked pose on the image edges (edge_refinement.h).
@@ -52,8 +52,8 @@ struct TrackerSettings {
   EdgeAlignmentOptions alignment;
   int max_iterations = 30;  // virtual visual servoing iterations per pass
   // Iterations of every pass but the last (0: max_iterations). The first pass only has to move
-  // the moving edges; capping it at 3-6 cuts the step by 15-20 % (mbt/cube 1.67x -> 1.37-1.42x
-  // ViSP's track()) but left 4-6 more wrong poses on the 300-frame hall drive: off by default.
+  // the moving edges, so capping it saves time, but the pose it hands over is rougher and more
+  // frames end wrong: off by default (docs/tracking.md, speed).
   int first_passes_max_iterations = 0;
   double good_edge_ratio = 0.4;     // ViSP gives up below this share of good moving edges
   std::string source = "defaults";  // the file the settings come from, for reports

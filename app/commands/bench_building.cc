@@ -1,0 +1,183 @@
+// `linetrack bench building`: the generated office building (models/synth/synthetic_building.h)
+// against each of its rooms modelled alone: the regions' build time and memory, localisation
+// per room under the paper's priors (QI1-3), and the localize median of both.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "app/commands.h"
+#include "app/match_outcome.h"
+#include "matching/evaluation/diagnosis.h"
+#include "matching/localizer.h"
+#include "models/navigable_area.h"
+#include "models/statistics.h"
+#include "models/synth/synthetic_building.h"
+#include "models/synth/synthetic_scenes.h"
+#include "models/view_invariant_regions.h"
+
+namespace linetrack::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct BenchBuildingOptions {
+  BuildingSpec spec;
+  int count = 100;  // scenes per room and prior
+  uint64_t seed = 1;
+  int max_rooms = 0;  // 0: every room
+  std::string out_path;
+};
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+double MaxRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // kilobytes on Linux
+}
+
+// A model with its area, regions and localizer.
+struct Setup {
+  std::unique_ptr<WireframeModel> model;
+  std::unique_ptr<NavigableArea> area;
+  std::unique_ptr<ViewInvariantRegions> regions;
+  std::unique_ptr<Localizer> localizer;
+  double regions_ms = 0.0;
+};
+
+Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera) {
+  Setup s;
+  s.model = std::make_unique<WireframeModel>(WireframeModel::FromCao(cao));
+  s.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*s.model));
+  const Clock::time_point start = Clock::now();
+  s.regions =
+      std::make_unique<ViewInvariantRegions>(ViewInvariantRegions::Build(*s.model, *s.area));
+  s.regions_ms = MsSince(start);
+  s.localizer = std::make_unique<Localizer>(*s.model, s.regions.get(), s.area.get(), camera);
+  return s;
+}
+
+// Correct answers of `count` scenes drawn in `sampling` (poses on `storey`), and the localize
+// times (milliseconds) appended to `times`.
+int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticSceneOptions o,
+                   std::vector<double>* times) {
+  const std::vector<SyntheticScene> scenes = GenerateScenes(*setup.model, sampling, o);
+  int correct = 0;
+  for (const SyntheticScene& scene : scenes) {
+    const LocalizationProblem problem = ProblemOf(scene);
+    const Clock::time_point start = Clock::now();
+    const LocalizationResult result = setup.localizer->Localize(problem);
+    times->push_back(MsSince(start));
+    correct += JudgeScene(scene, result) == MatchOutcome::kCorrect ? 1 : 0;
+  }
+  return correct;
+}
+
+// The room's own navigable area (its model alone's), standing on `storey` of the building.
+NavigableArea RoomArea(const NavigableArea& alone, int storey, const std::vector<Storey>& storeys) {
+  std::vector<AreaPart> parts = alone.parts();
+  for (AreaPart& part : parts)
+    part.storey = storey;
+  std::vector<std::vector<Segment2>> walls(storeys.size());
+  walls[storey] = alone.walls();
+  return NavigableArea::FromParts(std::move(parts), std::move(walls), storeys, alone.clearance(),
+                                  alone.source());
+}
+
+int RunBenchBuilding(const BenchBuildingOptions& opt) {
+  const CameraIntrinsics camera = PaperSyntheticCamera();
+  const SyntheticBuilding building = GenerateBuilding(opt.spec);
+  const double rss_before = MaxRssMb();
+  const Setup whole = Prepare(building.cao, camera);
+  const double rss_after = MaxRssMb();
+  std::ostringstream out;
+  char line[256];
+  int rooms = 0;
+  for (const BuildingSpace& space : building.spaces)
+    rooms += space.corridor ? 0 : 1;
+  std::snprintf(
+      line, sizeof(line),
+      "building: %d storeys, %d rooms, %zu edges, %zu faces; navigable area %.1f m2 in "
+      "%zu parts\nregions: %d built in %.0f ms, peak memory +%.0f MB (process %.0f MB)\n\n",
+      opt.spec.storeys, rooms, whole.model->edges().size(), whole.model->faces().size(),
+      whole.area->Area(), whole.area->parts().size(), whole.regions->size(), whole.regions_ms,
+      std::max(0.0, rss_after - rss_before), rss_after);
+  out << line
+      << "| room | QI1 building | QI1 alone | QI2 building | QI2 alone | QI3 building | "
+         "QI3 alone |\n| --- | --- | --- | --- | --- | --- | --- |\n";
+  std::vector<double> times_building, times_alone;
+  std::array<int, 3> sum_building{}, sum_alone{};
+  int done = 0;
+  for (size_t k = 0; k < building.spaces.size(); ++k) {
+    const BuildingSpace& room = building.spaces[k];
+    if (room.corridor || (opt.max_rooms > 0 && done >= opt.max_rooms)) continue;
+    ++done;
+    const Setup alone = Prepare(SpaceAlone(opt.spec, static_cast<int>(k)), camera);
+    const NavigableArea sampling = RoomArea(*alone.area, room.storey, whole.model->storeys());
+    out << "| " << room.name;
+    for (int qi = 1; qi <= 3; ++qi) {
+      SyntheticSceneOptions o;
+      o.seed = opt.seed + 1000 * k;
+      o.count = opt.count;
+      const PriorBounds bounds = QualityIndexBounds(qi);
+      o.delta_t = bounds.delta_t;
+      o.delta_phi = bounds.delta_phi;
+      o.floor_z = room.floor_z;
+      o.storey = room.storey;
+      const int b = CorrectAnswers(whole, sampling, o, &times_building);
+      o.storey = 0;
+      const int a = CorrectAnswers(alone, *alone.area, o, &times_alone);
+      sum_building[qi - 1] += b;
+      sum_alone[qi - 1] += a;
+      out << " | " << b << " | " << a;
+    }
+    out << " |\n";
+    std::cerr << "\rrooms " << done << std::flush;
+  }
+  std::cerr << "\n";
+  out << "| **all** ";
+  for (int qi = 0; qi < 3; ++qi)
+    out << "| **" << sum_building[qi] << "** | **" << sum_alone[qi] << "** ";
+  std::snprintf(line, sizeof(line),
+                "|\n\ncorrect of %d scenes per room and prior (seed %llu)\nlocalize median: "
+                "building %.3f ms, rooms alone %.3f ms (x %.2f)\n",
+                opt.count, static_cast<unsigned long long>(opt.seed), Median(times_building),
+                Median(times_alone), Median(times_building) / std::max(1e-9, Median(times_alone)));
+  out << line;
+  std::cout << out.str();
+  if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, out.str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddBenchBuilding(CLI::App& cli, CommandAction* action) {
+  auto opt = std::make_shared<BenchBuildingOptions>();
+  CLI::App* cmd = BenchGroup(cli)->add_subcommand(
+      "building",
+      "The generated office building against its rooms modelled alone: regions' build time and "
+      "memory, correct localisations per room under the paper's priors, localize medians");
+  cmd->add_option("--storeys", opt->spec.storeys, "Storeys")->capture_default_str();
+  cmd->add_option("--rooms-per-side", opt->spec.rooms_per_side, "Rooms per corridor side")
+      ->capture_default_str();
+  cmd->add_option("--count", opt->count, "Scenes per room and prior")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the scenes")->capture_default_str();
+  cmd->add_option("--rooms", opt->max_rooms, "Only the first N rooms (0: all)")
+      ->capture_default_str();
+  cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
+  cmd->callback([opt, action] {
+    if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
+    *action = [opt] { return RunBenchBuilding(*opt); };
+  });
+}
+
+}  // namespace linetrack::app

@@ -1,0 +1,113 @@
+// `linetrack ros`: the command line of the node. ROS's own arguments (remappings such as
+// image:=/cam/image_raw, __name:=, __ns:=) pass through to ros::init.
+#include <ros/ros.h>
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "app/ros/ros_commands.h"
+#include "app/ros/ros_node.h"
+#include "models/errors.h"
+#include "models/statistics.h"
+
+namespace linetrack::app {
+namespace {
+
+struct RosCommandOptions {
+  RosNodeOptions node;
+  std::vector<std::string> ros_args;  // name:=value
+  std::vector<std::string> given;     // the flags given, as parameter names
+};
+
+int RunRos(RosCommandOptions opt) {
+  ros::M_string remappings;
+  for (const std::string& arg : opt.ros_args) {
+    const size_t at = arg.find(":=");
+    if (at == std::string::npos || at == 0) {
+      throw InputError("ros: unexpected argument '" + arg + "' (ROS remappings are name:=value)");
+    }
+    remappings[arg.substr(0, at)] = arg.substr(at + 2);
+  }
+  ros::init(remappings, "linetrack", ros::init_options::NoSigintHandler);
+  if (!ros::master::check()) {
+    throw InputError("ros: no ROS master at " + ros::master::getURI() +
+                     " (start roscore, or set ROS_MASTER_URI)");
+  }
+  ros::NodeHandle nh, private_nh("~");
+  ReadRosParameters(private_nh, opt.given, &opt.node);
+  StopSignals signals;
+  RosNode node(opt.node, nh, private_nh);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  std::thread watcher([&node] {
+    while (ros::ok() && StopSignals::Received() == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    node.Stop();
+  });
+  spdlog::info("ros: node {} running (model {})", ros::this_node::getName(), opt.node.model);
+  node.Run();
+  ros::shutdown();
+  watcher.join();
+  const RosNodeStats stats = node.Stats();
+  std::cout << "ros: " << stats.received << " images, " << stats.dropped << " dropped, "
+            << stats.processed << " tracked, " << stats.with_pose << " poses on ~pose, "
+            << stats.degraded << " on ~pose_degraded";
+  if (!stats.overhead_ms.empty()) {
+    std::cout << "; beyond the tracking step median " << QuantileNearestRank(stats.overhead_ms, 0.5)
+              << " ms, p95 " << QuantileNearestRank(stats.overhead_ms, 0.95)
+              << " ms; waiting for the worker median " << QuantileNearestRank(stats.wait_ms, 0.5)
+              << " ms";
+  }
+  std::cout << std::endl;
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddRos(CLI::App& cli, CommandAction* action) {
+  auto opt = std::make_shared<RosCommandOptions>();
+  CLI::App* cmd = cli.add_subcommand(
+      "ros",
+      "ROS 1 node with AMCL's conventions: images, odometry, joint states and initialpose in; "
+      "~pose (PoseWithCovarianceStamped of the base in the map), map -> odom on /tf, ~status, "
+      "diagnostics and ~overlay out (docs/ros.md). Flags override the parameters (~model, ...); "
+      "remappings as name:=value");
+  RosNodeOptions& o = opt->node;
+  auto flag = [&](const char* name, const char* param, auto* value, const char* help) {
+    cmd->add_option(name, *value, help)->each([opt, param](const std::string&) {
+      opt->given.push_back(param);
+    });
+  };
+  flag("--model", "model", &o.model, "ViSP .cao model (parameter ~model); its frame is the map");
+  flag("--camera", "camera", &o.camera,
+       "Camera file: ViSP XML, OpenCV or ROS YAML (~camera); default: camera_info");
+  flag("--settings", "settings", &o.settings, "ViSP tracker XML (~settings)");
+  flag("--map-frame", "map_frame", &o.map_frame, "Map frame (~map_frame, default map)");
+  flag("--odom-frame", "odom_frame", &o.odom_frame, "Odometry frame (~odom_frame, default odom)");
+  flag("--base-frame", "base_frame", &o.base_frame, "Base frame (~base_frame, default base_link)");
+  flag("--height", "height", &o.height, "Camera height above the base's origin, metres (~height)");
+  flag("--tilt", "tilt", &o.tilt_deg,
+       "Camera tilt below the horizontal without a tilt joint, "
+       "degrees (~tilt)");
+  flag("--pan-joint", "pan_joint", &o.pan_joint, "Pan joint in joint_states (~pan_joint)");
+  flag("--tilt-joint", "tilt_joint", &o.tilt_joint, "Tilt joint in joint_states (~tilt_joint)");
+  flag("--alert-limit", "alert_limit", &o.integrity.alert_limit,
+       "METRES,DEGREES: a pose is 'tracking' (on ~pose) only when its protection levels are "
+       "within it, else 'degraded' (~pose_degraded) (~alert_limit, default 0.10,2)");
+  flag("--camera-sigma", "camera_sigma", &o.integrity.camera_sigma,
+       "Calibration uncertainty FOCAL_RELATIVE,PRINCIPAL_POINT_PX in the covariance "
+       "(~camera_sigma, default 0.003,1)");
+  flag("--model-sigma", "model_sigma", &o.integrity.model_sigma_m,
+       "Model error allowance, metres at each edge end (~model_sigma)");
+  flag("--odom-wait", "odom_wait", &o.odom_wait,
+       "Seconds an image waits for the odometry to reach its stamp (~odom_wait, default 0.05)");
+  flag("--transform-tolerance", "transform_tolerance", &o.transform_tolerance,
+       "Seconds added to the stamp of map -> odom, as AMCL (~transform_tolerance, default 0.1)");
+  // Remappings are positional, so that unknown flags still reach the global ones (-q).
+  cmd->add_option("remappings", opt->ros_args, "ROS remappings name:=value (__name, __log, ...)");
+  cmd->callback([opt, action] { *action = [opt] { return RunRos(*opt); }; });
+}
+
+}  // namespace linetrack::app

@@ -1,0 +1,108 @@
+// The maths of app/ros/ros_geometry.h on exact synthetic poses: the camera mount, AMCL's
+// map -> odom correction, the pose covariance in ROS's convention, the status, odometry
+// interpolation and the matcher's bounds from RViz's initial pose covariance.
+#include "app/ros/ros_geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+
+#include "app/ros/ros_tracker.h"
+#include "models/geometry.h"
+
+namespace linetrack::app {
+namespace {
+
+constexpr double kExact = 1e-9;
+
+// A camera 1.3 m above a base at (2, 3) heading 40 degrees, panned 25 and tilted 10 degrees.
+struct Scene {
+  CameraMount mount{1.3, DegToRad(25.0), DegToRad(10.0)};
+  Pose3Dof base{2.0, 3.0, DegToRad(40.0)};
+  Eigen::Isometry3d map_from_base = PlanarIsometry(base);
+  Eigen::Isometry3d cam_from_map = (map_from_base * BaseFromCamera(mount)).inverse();
+};
+
+TEST(RosGeometry, TheMountedCameraSeesWhatTheRobotPoseSays) {
+  const Scene s;
+  const Eigen::Isometry3d expected = CamFromWorld(CameraPrior(s.base, s.mount));
+  EXPECT_TRUE(s.cam_from_map.isApprox(expected, kExact));
+  EXPECT_TRUE(MapFromBase(s.cam_from_map, s.mount).isApprox(s.map_from_base, kExact));
+  const Pose3Dof planar = PlanarOf(s.map_from_base);
+  EXPECT_NEAR(planar.heading, s.base.heading, kExact);
+}
+
+TEST(RosGeometry, MapFromOdomComposesBackToTheTrackedBase) {
+  const Scene s;
+  const Eigen::Isometry3d odom_from_base = PlanarIsometry({0.4, -1.0, DegToRad(-70.0)});
+  const Eigen::Isometry3d map_from_odom = MapFromOdom(s.map_from_base, odom_from_base);
+  EXPECT_TRUE((map_from_odom * odom_from_base).isApprox(s.map_from_base, kExact));
+}
+
+// The base's origin is below the optical centre and turns with the camera about z: a twist
+// covariance in the camera centre's x, y and the heading (omega_z) alone is the base's x, y, yaw
+// covariance; without a covariance there is none.
+TEST(RosGeometry, PlanarTwistCovarianceIsTheBasesXYYaw) {
+  const Scene s;
+  Matrix6d twist = Matrix6d::Zero();
+  twist(0, 0) = 4e-4;
+  twist(1, 1) = 1e-4;
+  twist(0, 1) = twist(1, 0) = -5e-5;
+  twist(5, 5) = 3e-5;
+  twist(0, 5) = twist(5, 0) = 2e-5;
+  PoseUncertainty u;
+  u.world_covariance = twist;
+  const std::optional<Matrix6d> ros = RosCovarianceOf(u, s.cam_from_map, s.mount);
+  ASSERT_TRUE(ros.has_value());
+  const std::array<int, 3> planar = {0, 1, 5};
+  for (int i : planar) {
+    for (int j : planar) {
+      EXPECT_NEAR((*ros)(i, j), twist(i, j), kExact) << i << "," << j;
+    }
+  }
+  const Eigen::Matrix3d z_roll_pitch = ros->block<3, 3>(2, 2);
+  EXPECT_NEAR(z_roll_pitch.norm(), 0.0, kExact);  // z, roll, pitch: known
+  EXPECT_FALSE(RosCovarianceOf(PoseUncertainty(), s.cam_from_map, s.mount).has_value());
+}
+
+// ~status of a frame with a pose: the integrity monitor's word, relocalising for a degraded pose
+// while the matcher's pose is being confirmed.
+TEST(RosGeometry, StatusFollowsTheIntegrityMonitor) {
+  EXPECT_EQ(StatusOf(IntegrityStatus::kTracking, /*reacquiring=*/false), RosStatus::kTracking);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kDegraded, /*reacquiring=*/false), RosStatus::kDegraded);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kDegraded, /*reacquiring=*/true), RosStatus::kRelocalising);
+  EXPECT_EQ(StatusOf(IntegrityStatus::kLost, /*reacquiring=*/false), RosStatus::kLost);
+  EXPECT_STREQ(ToString(RosStatus::kRelocalising), "relocalising");
+}
+
+TEST(RosGeometry, OdometryIsInterpolatedAtTheImageStamp) {
+  const std::vector<StampedOdometry> readings = {
+      {10.0, PlanarIsometry({0.0, 0.0, 0.0})}, {10.2, PlanarIsometry({0.2, 0.4, DegToRad(20.0)})}};
+  const std::optional<Eigen::Isometry3d> mid = OdometryAt(readings, 10.05, 0.1);
+  ASSERT_TRUE(mid.has_value());
+  const Pose3Dof planar = PlanarOf(*mid);
+  EXPECT_NEAR(planar.x, 0.05, kExact);
+  EXPECT_NEAR(planar.y, 0.1, kExact);
+  EXPECT_NEAR(planar.heading, DegToRad(5.0), kExact);
+  EXPECT_TRUE(OdometryAt(readings, 10.25, 0.1).has_value());   // within the gap
+  EXPECT_FALSE(OdometryAt(readings, 10.35, 0.1).has_value());  // beyond it
+  EXPECT_FALSE(OdometryAt({}, 10.0, 0.1).has_value());
+}
+
+TEST(RosGeometry, RvizInitialPoseGivesThePapersBounds) {
+  Matrix6d rviz = Matrix6d::Zero();
+  rviz(0, 0) = rviz(1, 1) = 0.25;
+  rviz(5, 5) = 0.06853891945200942;
+  const SearchBounds bounds = BoundsFromCovariance(rviz, RelocalizationOptions());
+  EXPECT_NEAR(bounds.delta_t, 0.75, kExact);
+  EXPECT_NEAR(RadToDeg(bounds.delta_phi), 1.5 * RadToDeg(std::sqrt(rviz(5, 5))), kExact);
+  // A certain pose still gets the smallest bounds after a loss; a vague one the widest.
+  const SearchBounds tight = BoundsFromCovariance(Matrix6d::Zero(), RelocalizationOptions());
+  EXPECT_NEAR(tight.delta_t, RelocalizationOptions().after_loss.delta_t, kExact);
+  const SearchBounds wide =
+      BoundsFromCovariance(Matrix6d::Identity() * 100.0, RelocalizationOptions());
+  EXPECT_NEAR(wide.delta_t, RelocalizationOptions().max.delta_t, kExact);
+}
+
+}  // namespace
+}  // namespace linetrack::app

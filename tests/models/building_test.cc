@@ -1,0 +1,157 @@
+// The generated building: its size, its faces facing the free space as written (and coming back so
+// from reversed), two storeys, a navigable area per storey joining rooms and corridor through the
+// doors, regions that keep each storey to its own edges, and no finding of the model checks.
+#include "models/synth/synthetic_building.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "models/model_checks.h"
+#include "models/navigable_area.h"
+#include "models/view_invariant_regions.h"
+#include "models/wireframe.h"
+
+namespace linetrack {
+namespace {
+
+constexpr double kAreaTolM2 = 1e-6;
+constexpr double kHeightTolM = 1e-9;
+constexpr double kSlabTolM = 0.05;
+// Footprint of a radiator (models/synth/synthetic_building.cc): 1.2 m long, 0.12 m deep (m^2).
+constexpr double kRadiatorArea = 1.2 * 0.12;
+
+class Building : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    building_ = new SyntheticBuilding(GenerateBuilding(BuildingSpec()));
+    model_ = new WireframeModel(WireframeModel::FromCao(building_->cao));
+    area_ = new NavigableArea(NavigableArea::FromModel(*model_));
+  }
+  static void TearDownTestSuite() {
+    delete area_;
+    delete model_;
+    delete building_;
+  }
+  static SyntheticBuilding* building_;
+  static WireframeModel* model_;
+  static NavigableArea* area_;
+};
+
+SyntheticBuilding* Building::building_ = nullptr;
+WireframeModel* Building::model_ = nullptr;
+NavigableArea* Building::area_ = nullptr;
+
+TEST_F(Building, HasTheSizeOfTheScaleTargets) {
+  int rooms = 0;
+  for (const BuildingSpace& space : building_->spaces)
+    rooms += space.corridor ? 0 : 1;
+  EXPECT_EQ(rooms, 36);
+  EXPECT_GE(model_->edges().size(), 2000u);
+  ASSERT_EQ(model_->storeys().size(), 2u);
+  const BuildingSpec spec;
+  EXPECT_NEAR(model_->storeys()[0].floor_z, 0.0, kHeightTolM);
+  EXPECT_NEAR(model_->storeys()[0].top_z, spec.storey_height, kHeightTolM);
+  EXPECT_NEAR(model_->storeys()[1].floor_z, spec.storey_height + spec.slab, kHeightTolM);
+}
+
+TEST_F(Building, IsWrittenFacingTheFreeSpace) {
+  EXPECT_TRUE(model_->oriented());
+  EXPECT_TRUE(model_->orientation_summary().empty()) << model_->orientation_summary().front();
+}
+
+TEST_F(Building, ReversedFacesComeBackAsWritten) {
+  std::mt19937 rng(7u);
+  std::bernoulli_distribution pick(0.5);
+  CaoModel reversed = building_->cao;
+  for (std::vector<int>& face : reversed.faces) {
+    if (pick(rng)) std::reverse(face.begin(), face.end());
+  }
+  const WireframeModel turned = WireframeModel::FromCao(reversed);
+  ASSERT_EQ(turned.faces().size(), model_->faces().size());
+  for (size_t f = 0; f < turned.faces().size(); ++f)
+    EXPECT_EQ(turned.faces()[f].vertices, model_->faces()[f].vertices) << "face " << f;
+  ASSERT_EQ(turned.edges().size(), model_->edges().size());
+  for (size_t e = 0; e < turned.edges().size(); ++e) {
+    EXPECT_EQ(turned.edges()[e].v0, model_->edges()[e].v0) << "edge " << e;
+    EXPECT_EQ(turned.edges()[e].v1, model_->edges()[e].v1) << "edge " << e;
+  }
+}
+
+TEST_F(Building, EachStoreyIsOneAreaJoinedThroughTheDoors) {
+  ASSERT_EQ(area_->parts().size(), 2u);
+  const BuildingSpec spec;
+  for (int s = 0; s < 2; ++s) {
+    // Rooms, corridor and door thresholds, minus the footprints of the pillars, low boxes,
+    // cabinets and radiators (1.2 m x 0.12 m under each room's window: rooms >= 3 m wide).
+    double expected = 0.0;
+    int rooms = 0;
+    for (size_t k = 0; k < building_->spaces.size(); ++k) {
+      const BuildingSpace& space = building_->spaces[k];
+      if (space.storey != s) continue;
+      expected += (space.hi - space.lo).prod();
+      if (space.corridor) continue;
+      const int kind = (s * 2 * spec.rooms_per_side + rooms) % 3;
+      expected += spec.door_width * spec.wall - (kind == 0 ? 0.16 : kind == 1 ? 0.6 : 0.6);
+      ASSERT_GE(space.hi.x() - space.lo.x(), 3.0) << space.name;
+      expected -= kRadiatorArea;
+      ++rooms;
+    }
+    EXPECT_NEAR(area_->Area(s), expected, kAreaTolM2) << "storey " << s;
+    for (const BuildingSpace& space : building_->spaces) {
+      if (space.storey != s) continue;
+      // A point 0.5 m from the space's west wall, half way across (clear of the furniture).
+      const Eigen::Vector2d p(space.lo.x() + 0.5, 0.5 * (space.lo.y() + space.hi.y()));
+      EXPECT_TRUE(area_->Contains(p, s)) << space.name;
+    }
+  }
+}
+
+TEST_F(Building, RegionsKeepEachStoreyToItsOwnEdges) {
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(*model_, *area_);
+  const BuildingSpec spec;
+  for (int s = 0; s < 2; ++s) {
+    const BuildingSpace& corridor = building_->spaces[building_->spaces.size() - 2 + s];
+    VisibilityQuery query;
+    query.centre = 0.5 * (corridor.lo + corridor.hi);
+    query.radius = 0.5;
+    query.heading_margin = kPi;
+    query.camera_z = corridor.floor_z + 1.3;
+    const std::vector<int> ids = regions.Query(query);
+    ASSERT_FALSE(ids.empty());
+    // The slab hides the other storey: storey 0 lists nothing above its ceiling, storey 1
+    // nothing below its floor.
+    for (int id : ids) {
+      const ModelEdge& edge = model_->edges()[id];
+      if (s == 0) {
+        EXPECT_LE(std::min(edge.segment.a.z(), edge.segment.b.z()), spec.storey_height + kSlabTolM)
+            << "edge " << id;
+      } else {
+        EXPECT_GE(std::max(edge.segment.a.z(), edge.segment.b.z()),
+                  spec.storey_height + spec.slab - kSlabTolM)
+            << "edge " << id;
+      }
+    }
+  }
+}
+
+TEST_F(Building, PassesTheModelChecks) {
+  const std::vector<ModelFinding> findings = CheckModel(*model_);
+  EXPECT_TRUE(findings.empty()) << findings.front().message;
+}
+
+TEST(BuildingAlone, EveryRoomAloneEnclosesItsSpace) {
+  const BuildingSpec spec;
+  const SyntheticBuilding building = GenerateBuilding(spec);
+  for (size_t k = 0; k < building.spaces.size(); ++k) {
+    const WireframeModel alone = WireframeModel::FromCao(SpaceAlone(spec, static_cast<int>(k)));
+    EXPECT_TRUE(alone.oriented()) << building.spaces[k].name;
+    EXPECT_TRUE(alone.orientation_summary().empty())
+        << building.spaces[k].name << ": " << alone.orientation_summary().front();
+    const NavigableArea area = NavigableArea::FromModel(alone);
+    EXPECT_EQ(area.parts().size(), 1u) << building.spaces[k].name;
+  }
+}
+
+}  // namespace
+}  // namespace linetrack
