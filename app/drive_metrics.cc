@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "models/errors.h"
+#include "models/text_format.h"
 
 namespace linetrack::app {
 namespace {
@@ -34,12 +35,6 @@ std::optional<double> OptionalNumber(const std::string& field, const std::string
     throw InputError(where + ": '" + field + "' is not a finite number");
   }
   return value;
-}
-
-std::string Fixed(double value, int decimals) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
-  return text;
 }
 
 std::string Percent(int part, int whole) {

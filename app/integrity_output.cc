@@ -73,6 +73,8 @@ IntegrityOptions IntegrityFlags::Options(const IntegrityOptions& base) const {
   }
   CheckRange(model_sigma_m, 0.0, 1.0, "--model-sigma");
   options.solver.noise.model_sigma_m = model_sigma_m;
+  CheckRange(casing_sigma_m, 0.0, 1.0, "--casing-sigma");
+  options.solver.noise.casing_sigma_m = casing_sigma_m;
   CheckRange(edge_fault_prior, 0.0, 0.5, "--edge-fault-prior");
   options.edge_fault_probability = edge_fault_prior;
   std::string why;
@@ -91,6 +93,10 @@ void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags) {
   cmd->add_option("--model-sigma", flags->model_sigma_m,
                   "Model error allowance: how far the model's edges may be from the real ones "
                   "(metres, each end)")
+      ->capture_default_str();
+  cmd->add_option("--casing-sigma", flags->casing_sigma_m,
+                  "How far a door or window casing may pull a frame line's edge (metres; the "
+                  "model's 3D lines drawn on a face; 0: not at all)")
       ->capture_default_str();
   cmd->add_option("--edge-fault-prior", flags->edge_fault_prior,
                   "Prior probability that one edge's points are wrong beyond the noise (latched "

@@ -20,6 +20,7 @@ struct IntegrityFlags {
   std::string alert_limit = "0.10,2";  // metres, degrees
   std::string camera_sigma;            // FOCAL_RELATIVE,PRINCIPAL_POINT_PX (default: the solver's)
   double model_sigma_m = EdgeNoiseOptions().model_sigma_m;
+  double casing_sigma_m = EdgeNoiseOptions().casing_sigma_m;
   double edge_fault_prior = IntegrityOptions().edge_fault_probability;
   bool all_poses = false;  // poses.txt: every pose, not only those tracking
 
@@ -27,8 +28,8 @@ struct IntegrityFlags {
   IntegrityOptions Options(const IntegrityOptions& base = IntegrityOptions()) const;
 };
 
-// Adds --alert-limit, --camera-sigma, --model-sigma and --edge-fault-prior to `cmd`;
-// AddAllPosesFlag --all-poses.
+// Adds --alert-limit, --camera-sigma, --model-sigma, --casing-sigma and --edge-fault-prior to
+// `cmd`; AddAllPosesFlag --all-poses.
 void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags);
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags);
 

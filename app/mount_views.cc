@@ -108,7 +108,11 @@ MountViews GrabMountViews(const MountViewsPlan& plan, const PatternSpec& pattern
     throw InputError("--source " + plan.source_spec + " --head " + plan.head_spec +
                      ": the simulated camera and the simulated head go together");
   }
-  if (source.kind == SourceKind::kSim) return GrabSimulated(plan, pattern, camera, source.argument);
+  if (source.kind == SourceKind::kSim) {
+    MountViews views = GrabSimulated(plan, pattern, camera, source.argument);
+    views.distortion = DistortionModel::kInverseOfKdu;
+    return views;
+  }
   FrameSourceOptions sources;
   sources.aravis.width = camera.width;
   sources.aravis.height = camera.height;

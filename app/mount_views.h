@@ -37,6 +37,8 @@ struct MountViews {
   std::vector<cv::Mat> images;     // 8-bit grey, the camera's size
   std::vector<HeadAngles> angles;  // the head's readings
   std::string source, head;        // descriptions for the log
+  // The camera's distortion in these images: the simulator draws the inverse of kdu.
+  DistortionModel distortion = DistortionModel::kKud;
 };
 
 // The chessboard in the simulated world: centred `distance` metres along the optical axis of the

@@ -10,17 +10,12 @@
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "models/statistics.h"
+#include "models/text_format.h"
 #include "models/trajectory_io.h"
 
 namespace linetrack::app {
 
 namespace {
-
-std::string Fixed(double value, int decimals) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
-  return text;
-}
 
 nlohmann::ordered_json Percentiles(const std::vector<double>& values) {
   return {{"p50", QuantileNearestRank(values, 0.5)},

@@ -100,7 +100,7 @@ bool EstimateOnViews(const std::vector<size_t>& used, const std::vector<ViewData
   result->hand_eye_status = start.visp_status;
   std::vector<Eigen::Isometry3d> poses = {
       start.tilt_from_camera, BoardInBase(angles[0], start.tilt_from_camera, cam_from_board[0])};
-  const PoseResiduals residuals = MountResiduals(camera, views, angles);
+  const PoseResiduals residuals = MountResiduals(camera, views, angles, options.distortion);
   const PoseLeastSquaresResult solved = SolvePoseLeastSquares(residuals, options.solver, &poses);
   if (!solved.ok) {
     result->status = MountStatus::kEstimationFailed;
@@ -150,9 +150,9 @@ int MountCalibration::UsedViews() const {
 }
 
 PoseResiduals MountResiduals(const CameraIntrinsics& camera, const std::vector<BoardView>& views,
-                             const std::vector<HeadAngles>& angles) {
-  return [&camera, &views, &angles](const std::vector<Eigen::Isometry3d>& poses, Eigen::VectorXd* r,
-                                    Eigen::MatrixXd* jacobian) {
+                             const std::vector<HeadAngles>& angles, DistortionModel model) {
+  return [&camera, &views, &angles, model](const std::vector<Eigen::Isometry3d>& poses,
+                                           Eigen::VectorXd* r, Eigen::MatrixXd* jacobian) {
     const Eigen::Isometry3d& mount = poses[0];
     const Eigen::Isometry3d& board = poses[1];
     Eigen::Index n = 0;
@@ -173,8 +173,8 @@ PoseResiduals MountResiduals(const CameraIntrinsics& camera, const std::vector<B
             tilt_from_base * (rotated + board.translation()) - mount.translation();
         const Eigen::Vector3d p = camera_from_tilt * from_camera;
         if (!(p.z() > 0.0)) return false;
-        r->segment<2>(row) =
-            ProjectPoint(camera, p, jacobian ? &d_pixel : nullptr) - views[v].image_points[k];
+        r->segment<2>(row) = ProjectPoint(camera, p, jacobian ? &d_pixel : nullptr, model) -
+                             views[v].image_points[k];
         if (jacobian == nullptr) continue;
         // Mount (t_m + s, Exp(w) R_m): dp/ds = -R_m^T, dp/dw = R_m^T [Y - t_m]x.
         // Board (t_b + s, Exp(w) R_b): dp/ds = R_m^T R_h^T, dp/dw = -R_m^T R_h^T [R_b X]x.

@@ -41,6 +41,9 @@ struct MountCalibrationOptions {
   int min_views = 4;  // fewer usable views: refused
   // RotationAxisSpread of the views below this: the head turned about one axis only.
   double min_axis_spread = 0.05;
+  // The camera's distortion in the joint refinement: kud (a camera from `calibrate`), or the
+  // inverse of kdu for images the scene renderer drew (the simulated camera).
+  DistortionModel distortion = DistortionModel::kKud;
 
   bool Check(std::string* why) const;
 };
@@ -90,7 +93,8 @@ struct MountCalibration {
 // {tilt_from_camera, base_from_board}, with their analytic Jacobian (SolvePoseLeastSquares'
 // conventions). It refers to its arguments, which must outlive it.
 PoseResiduals MountResiduals(const CameraIntrinsics& camera, const std::vector<BoardView>& views,
-                             const std::vector<HeadAngles>& angles);
+                             const std::vector<HeadAngles>& angles,
+                             DistortionModel model = DistortionModel::kKud);
 
 // The calibration from detections (names, angles and detections in the same order). `camera` is
 // the camera's calibrated model (with its distortion).

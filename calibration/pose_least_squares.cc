@@ -29,18 +29,35 @@ Eigen::Matrix3d SkewMatrix(const Eigen::Vector3d& v) {
 }
 
 Eigen::Vector2d ProjectPoint(const CameraIntrinsics& camera, const Eigen::Vector3d& p,
-                             Eigen::Matrix<double, 2, 3>* d_pixel_d_point) {
-  const double kud = camera.has_distortion ? camera.kud : 0.0;
+                             Eigen::Matrix<double, 2, 3>* d_pixel_d_point, DistortionModel model) {
   const double x = p.x() / p.z(), y = p.y() / p.z();
+  // d(x, y)/dp = [1/Z 0 -x/Z; 0 1/Z -y/Z].
+  Eigen::Matrix<double, 2, 3> d_normalised;
+  d_normalised << 1.0 / p.z(), 0.0, -x / p.z(), 0.0, 1.0 / p.z(), -y / p.z();
+  const Eigen::DiagonalMatrix<double, 2> focal(camera.px, camera.py);
+  if (model == DistortionModel::kInverseOfKdu) {
+    const Eigen::Vector2d pixel =
+        DistortedPixelOf(camera, {camera.u0 + camera.px * x, camera.v0 + camera.py * y});
+    if (d_pixel_d_point != nullptr) {
+      // The distorted normalised point d solves d (1 + kdu |d|^2) = (x, y): its derivative is
+      // the inverse of M = (1 + kdu |d|^2) I + 2 kdu d d^T.
+      const double kdu = camera.has_distortion ? camera.kdu : 0.0;
+      const Eigen::Vector2d d((pixel.x() - camera.u0) / camera.px,
+                              (pixel.y() - camera.v0) / camera.py);
+      const Eigen::Matrix2d m = (1.0 + kdu * d.squaredNorm()) * Eigen::Matrix2d::Identity() +
+                                2.0 * kdu * d * d.transpose();
+      *d_pixel_d_point = focal * (m.inverse() * d_normalised);
+    }
+    return pixel;
+  }
+  const double kud = camera.has_distortion ? camera.kud : 0.0;
   const double k = 1.0 + kud * (x * x + y * y);
   if (d_pixel_d_point != nullptr) {
-    // d(x k)/dx = k + 2 kud x^2, d(x k)/dy = 2 kud x y; d(x, y)/dp = [1/Z 0 -x/Z; 0 1/Z -y/Z].
+    // d(x k)/dx = k + 2 kud x^2, d(x k)/dy = 2 kud x y.
     Eigen::Matrix2d d_distorted;
-    d_distorted << camera.px * (k + 2.0 * kud * x * x), camera.px * 2.0 * kud * x * y,
-        camera.py * 2.0 * kud * x * y, camera.py * (k + 2.0 * kud * y * y);
-    Eigen::Matrix<double, 2, 3> d_normalised;
-    d_normalised << 1.0 / p.z(), 0.0, -x / p.z(), 0.0, 1.0 / p.z(), -y / p.z();
-    *d_pixel_d_point = d_distorted * d_normalised;
+    d_distorted << k + 2.0 * kud * x * x, 2.0 * kud * x * y, 2.0 * kud * x * y,
+        k + 2.0 * kud * y * y;
+    *d_pixel_d_point = focal * (d_distorted * d_normalised);
   }
   return {camera.u0 + camera.px * x * k, camera.v0 + camera.py * y * k};
 }

@@ -15,11 +15,18 @@
 
 namespace linetrack {
 
-// Pixel of the camera-frame point p (z > 0) under `camera`: u = u0 + px x (1 + kud r^2),
-// v = v0 + py y (1 + kud r^2), (x, y) = (X / Z, Y / Z), r^2 = x^2 + y^2 (kud = 0 without
-// distortion), and the derivative d(u, v) / dp when `d_pixel_d_point` is not null.
+// Which one-term radial model maps undistorted to distorted pixels (docs/conventions.md).
+enum class DistortionModel {
+  kKud,          // ViSP's projection: x_d = x (1 + kud |x|^2), what `calibrate` fits
+  kInverseOfKdu  // x_d solving x_d (1 + kdu |x_d|^2) = x: what the scene renderer draws
+};
+
+// Pixel of the camera-frame point p (z > 0) under `camera`: u0 + px x_d, v0 + py y_d with x_d
+// the distorted image of (x, y) = (X / Z, Y / Z) under `model` (x_d = x without distortion),
+// and the derivative d(u, v) / dp when `d_pixel_d_point` is not null.
 Eigen::Vector2d ProjectPoint(const CameraIntrinsics& camera, const Eigen::Vector3d& p,
-                             Eigen::Matrix<double, 2, 3>* d_pixel_d_point);
+                             Eigen::Matrix<double, 2, 3>* d_pixel_d_point,
+                             DistortionModel model = DistortionModel::kKud);
 
 // The cross-product matrix [v]x: [v]x a = v x a.
 Eigen::Matrix3d SkewMatrix(const Eigen::Vector3d& v);

@@ -21,7 +21,14 @@ std::string ReadCameraText(const std::string& path) {
   if (!in || !std::filesystem::is_regular_file(path, ec)) {
     throw InputError(Located(path, 0, "cannot read the camera file"));
   }
-  return text.str();
+  // A NUL byte means a binary file; OpenCV's FileStorage parser also dereferences null on some.
+  std::string contents = text.str();
+  const size_t nul = contents.find('\0');
+  if (nul != std::string::npos) {
+    throw InputError(
+        Located(path, 0, "not a text file (a NUL byte at offset " + std::to_string(nul) + ")"));
+  }
+  return contents;
 }
 
 namespace {
@@ -119,6 +126,25 @@ Eigen::Vector2d CameraIntrinsics::Undistort(const Eigen::Vector2d& uv) const {
   const double x = (uv.x() - u0) / px, y = (uv.y() - v0) / py;
   const double k = 1.0 + kdu * (x * x + y * y);
   return {u0 + px * x * k, v0 + py * y * k};
+}
+
+Eigen::Vector2d DistortedPixelOf(const CameraIntrinsics& camera, const Eigen::Vector2d& uv) {
+  if (!camera.has_distortion || camera.kdu == 0.0) return uv;
+  const double x = (uv.x() - camera.u0) / camera.px, y = (uv.y() - camera.v0) / camera.py;
+  const double rho_u = std::hypot(x, y);
+  if (rho_u == 0.0) return uv;
+  // Solve rho_d (1 + kdu rho_d^2) = rho_u; increasing in rho_d while 1 + 3 kdu rho_d^2 > 0.
+  double rho = rho_u;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const double f = rho * (1.0 + camera.kdu * rho * rho) - rho_u;
+    const double slope = 1.0 + 3.0 * camera.kdu * rho * rho;
+    if (slope <= 1e-6) break;
+    const double step = f / slope;
+    rho -= step;
+    if (std::abs(step) < 1e-13) break;
+  }
+  const double scale = rho / rho_u;
+  return {camera.u0 + camera.px * x * scale, camera.v0 + camera.py * y * scale};
 }
 
 CameraIntrinsics ReadCameraXml(const std::string& path, const std::string& name, int width,

@@ -46,6 +46,12 @@ struct CameraIntrinsics {
   }
 };
 
+// The distorted pixel q with camera.Undistort(q) = uv: the exact inverse of the kdu model
+// (x_u = x_d (1 + kdu r_d^2) in normalised coordinates), solved radially by Newton's method.
+// This is what the renderer draws (output pixel q shows undistorted pixel Undistort(q)); ViSP's
+// kud model is only an approximate inverse. Identity without distortion.
+Eigen::Vector2d DistortedPixelOf(const CameraIntrinsics& camera, const Eigen::Vector2d& uv);
+
 // The text of a camera file. Throws InputError naming the file when it is missing or unreadable.
 std::string ReadCameraText(const std::string& path);
 

@@ -83,15 +83,31 @@ CameraFile MakeCameraFile(CameraIntrinsics camera, const BrownConrady& distortio
   return file;
 }
 
-std::vector<double> MatValues(const cv::FileNode& node) {
-  cv::Mat m;
-  node >> m;
+// The values of an OpenCV matrix node (rows, cols, data), row-major. Its size is checked before
+// anything is read: cv::read allocates rows x cols as written, however large.
+std::vector<double> MatValues(const cv::FileNode& node, const std::string& path,
+                              const std::string& field) {
   std::vector<double> values;
-  if (m.empty()) return values;
-  cv::Mat d;
-  m.convertTo(d, CV_64F);
-  d = d.reshape(1, 1);
-  values.assign(d.ptr<double>(0), d.ptr<double>(0) + d.total());
+  if (node.empty() || node.isNone()) return values;
+  constexpr int kMaxSide = 16;
+  const bool shaped =
+      node.isMap() && node["rows"].isInt() && node["cols"].isInt() && node["data"].isSeq();
+  if (!shaped) throw InputError(Located(path, 0, field + ": expected rows, cols and a data list"));
+  const int rows = static_cast<int>(node["rows"]);
+  const int cols = static_cast<int>(node["cols"]);
+  const cv::FileNode data = node["data"];
+  if (rows < 1 || cols < 1 || rows > kMaxSide || cols > kMaxSide ||
+      static_cast<size_t>(rows) * static_cast<size_t>(cols) != data.size()) {
+    throw InputError(Located(path, 0,
+                             field + ": " + std::to_string(rows) + " x " + std::to_string(cols) +
+                                 " does not match its " + std::to_string(data.size()) + " values"));
+  }
+  for (const cv::FileNode& v : data) {
+    if (!v.isInt() && !v.isReal()) {
+      throw InputError(Located(path, 0, field + ": data holds a value that is not a number"));
+    }
+    values.push_back(static_cast<double>(v));
+  }
   return values;
 }
 
@@ -206,19 +222,27 @@ CameraFile ParseOpenCvCamera(const std::string& text, const std::string& path) {
     storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
   } catch (const cv::Exception& e) {
     throw InputError(Located(path, 0, "malformed OpenCV file: " + e.msg));
+  } catch (const std::exception& e) {  // OpenCV's parser passes on std::length_error and others
+    throw InputError(Located(path, 0, std::string("malformed OpenCV file: ") + e.what()));
   }
   if (!storage.isOpened()) throw InputError(Located(path, 0, "malformed OpenCV file"));
   try {
     const cv::FileNode k = storage["camera_matrix"];
     if (k.empty()) throw InputError(Located(path, 0, "no camera_matrix in this OpenCV file"));
-    CameraIntrinsics camera = FromCameraMatrix(MatValues(k), path, "camera_matrix");
+    CameraIntrinsics camera =
+        FromCameraMatrix(MatValues(k, path, "camera_matrix"), path, "camera_matrix");
     if (!storage["image_width"].empty()) camera.width = static_cast<int>(storage["image_width"]);
     if (!storage["image_height"].empty()) camera.height = static_cast<int>(storage["image_height"]);
-    const BrownConrady distortion = FromCoefficients(MatValues(storage["distortion_coefficients"]),
-                                                     path, "distortion_coefficients");
+    const BrownConrady distortion = FromCoefficients(
+        MatValues(storage["distortion_coefficients"], path, "distortion_coefficients"), path,
+        "distortion_coefficients");
     return MakeCameraFile(camera, distortion, CameraFileFormat::kOpenCv, path);
+  } catch (const InputError&) {
+    throw;
   } catch (const cv::Exception& e) {
     throw InputError(Located(path, 0, "malformed OpenCV file: " + e.msg));
+  } catch (const std::exception& e) {
+    throw InputError(Located(path, 0, std::string("malformed OpenCV file: ") + e.what()));
   }
 }
 

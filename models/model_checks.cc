@@ -8,6 +8,7 @@
 #include "models/convex_polygon.h"
 #include "models/errors.h"
 #include "models/free_space.h"
+#include "models/text_format.h"
 
 namespace linetrack {
 namespace {
@@ -16,12 +17,6 @@ namespace {
 constexpr int kLineSamples = 5;
 // Open wall ends listed in a finding at most.
 constexpr size_t kMaxListed = 3;
-
-std::string Fixed(double value, int digits = 2) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
-  return buffer;
-}
 
 double DistanceToSegment3(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                           const Eigen::Vector3d& b) {

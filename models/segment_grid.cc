@@ -37,6 +37,13 @@ double RayHit(const Eigen::Vector2d& a, const Eigen::Vector2d& d, const Segment2
   return u >= 0.0 && u <= 1.0 ? t : std::numeric_limits<double>::infinity();
 }
 
+// floor(value) clamped to [0, count - 1] before the cast (NaN gives 0): no overflow.
+int ClampedIndex(double value, int count) {
+  const double f = std::floor(value);
+  if (!(f > 0.0)) return 0;
+  return f >= count - 1 ? count - 1 : static_cast<int>(f);
+}
+
 }  // namespace
 
 SegmentGrid::SegmentGrid(std::vector<Segment2> segments, double min_cell)
@@ -71,11 +78,11 @@ bool SegmentGrid::ClipToGrid(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 }
 
 int SegmentGrid::Col(double x) const {
-  return std::clamp(static_cast<int>(std::floor((x - origin_.x()) / cell_)), 0, cols_ - 1);
+  return ClampedIndex((x - origin_.x()) / cell_, cols_);
 }
 
 int SegmentGrid::Row(double y) const {
-  return std::clamp(static_cast<int>(std::floor((y - origin_.y()) / cell_)), 0, rows_ - 1);
+  return ClampedIndex((y - origin_.y()) / cell_, rows_);
 }
 
 std::vector<int> SegmentGrid::Near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {

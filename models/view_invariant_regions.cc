@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <thread>
 
 #include "models/convex_polygon.h"
 #include "models/errors.h"
@@ -42,11 +44,19 @@ struct StoreyEdges {
   const std::vector<std::vector<int>>* one_sided_faces = nullptr;  // OneSidedFacesOfEdges
 };
 
-// True when segments p-q and s meet (touching counts).
-bool SegmentsMeet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Segment2& s) {
+// True when segments p-q and s meet (touching counts). `d_norm` and `e_norm` are |q - p| and
+// |s.b - s.a|.
+bool SegmentsMeet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double d_norm,
+                  const Segment2& s, double e_norm) {
   const Eigen::Vector2d d = q - p, e = s.b - s.a;
+  // Signed areas s1, s2 of (d, s.a - p) and (d, s.b - p). Where the lines cross, s sits at
+  // u = s1 / (s1 - s2); with both ends on one side of line p-q farther than the tolerances below
+  // (1e-9 of u, kPlanTolerance for parallel segments), twice over for rounding, they cannot meet.
+  const double s1 = Cross2(d, s.a - p), s2 = Cross2(d, s.b - p);
+  const double clear = 2.0 * d_norm * std::max(kPlanTolerance, 1e-9 * e_norm);
+  if ((s1 > clear && s2 > clear) || (s1 < -clear && s2 < -clear)) return false;
   const double denom = Cross2(d, e);
-  if (std::abs(denom) <= 1e-15 * d.norm() * e.norm()) {
+  if (std::abs(denom) <= 1e-15 * d_norm * e_norm) {
     return DistanceToSegment(p, s) <= kPlanTolerance || DistanceToSegment(q, s) <= kPlanTolerance;
   }
   const double t = Cross2(s.a - p, e) / denom, u = Cross2(s.a - p, d) / denom;
@@ -56,6 +66,7 @@ bool SegmentsMeet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Segm
 // The occluders and solids of one storey, in grids along which sight lines are walked.
 struct StoreyOccluders {
   SegmentGrid walls;
+  std::vector<double> wall_lengths;  // per wall of `walls` (metres)
   std::vector<Ring2> solids;
   SegmentGrid solid_sides;             // the solids' sides
   std::vector<int> solid_of_side;      // per side: its solid
@@ -71,9 +82,10 @@ bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footp
   for (const Eigen::Vector2d& f : footprint)
     to += f / static_cast<double>(footprint.size());
   int crossed = 0;
+  const double sight_length = (to - from).norm();
   const bool by_wall = o.walls.Along(from, to, [&](int i) {
     const Segment2& wall = o.walls.segments()[i];
-    if (!SegmentsMeet(from, to, wall)) return false;
+    if (!SegmentsMeet(from, to, sight_length, wall, o.wall_lengths[i])) return false;
     ++crossed;
     return HiddenByWall(region, footprint, wall, margin);
   });
@@ -223,6 +235,35 @@ StoreyEdges EdgesOfStorey(const WireframeModel& model, const std::vector<Storey>
   return edges;
 }
 
+// Calls job(i, occluders) for i in [0, n) on `threads` threads (0: the hardware's; at most one per
+// 64 jobs): thread w takes i = w, w + workers, ..., each with its own copy of the occluders (their
+// walks keep per-query marks). The jobs must be independent.
+template <typename Job>
+void ForEach(size_t n, int threads, const StoreyOccluders& occluders, const Job& job) {
+  const size_t wanted =
+      threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
+  const size_t workers = std::max<size_t>(1, std::min(wanted, n / 64));
+  // A job's exception is caught in its thread and rethrown here once every thread has ended.
+  std::vector<std::exception_ptr> failures(workers);
+  auto run = [&](size_t w, const StoreyOccluders& own) {
+    try {
+      for (size_t i = w; i < n; i += workers)
+        job(i, own);
+    } catch (...) {
+      failures[w] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w)
+    pool.emplace_back([&, w] { run(w, StoreyOccluders(occluders)); });
+  run(0, occluders);
+  for (std::thread& thread : pool)
+    thread.join();
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
+}
+
 }  // namespace
 
 bool ViewInvariantRegionsOptions::Check(std::string* why) const {
@@ -244,6 +285,10 @@ bool ViewInvariantRegionsOptions::Check(std::string* why) const {
   }
   if (!(min_region_size >= 0.0 && min_region_size <= 100.0)) {
     *why = "min_region_size must be in [0, 100] metres";
+    return false;
+  }
+  if (!(threads >= 0 && threads <= 256)) {
+    *why = "threads must be in [0, 256] (0: the hardware's)";
     return false;
   }
   if (!(hidden_margin >= 1e-6 && hidden_margin < 0.1)) {
@@ -304,7 +349,9 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   edges.z_lo = z_lo;
   edges.z_hi = z_hi;
   edges.one_sided_faces = &one_sided;
-  StoreyOccluders occluders{SegmentGrid(walls), {}, SegmentGrid({}), {}, {}, 0};
+  StoreyOccluders occluders{SegmentGrid(walls), {}, {}, SegmentGrid({}), {}, {}, 0};
+  for (const Segment2& wall : occluders.walls.segments())
+    occluders.wall_lengths.push_back((wall.b - wall.a).norm());
   occluders.solids = Solids(walls, cells, kMaxSolidSides);
   if (options.event_rays) {
     EventRayOptions rays;
@@ -330,24 +377,23 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   // The initial cells' lists first; a region split from one tests only its cell's list.
   std::vector<int> all(edges.ids.size());
   std::iota(all.begin(), all.end(), 0);
-  std::vector<std::vector<int>> parent_lists;
-  for (const Cell& cell : initial) {
-    std::vector<int> listed;
+  std::vector<std::vector<int>> parent_lists(initial.size());
+  ForEach(initial.size(), options.threads, occluders, [&](size_t i, const StoreyOccluders& own) {
     for (const RegionEdge& e :
-         VisibilityList(cell.ring, model, edges, all, occluders, options.hidden_margin)) {
-      listed.push_back(static_cast<int>(
+         VisibilityList(initial[i].ring, model, edges, all, own, options.hidden_margin)) {
+      parent_lists[i].push_back(static_cast<int>(
           std::lower_bound(edges.ids.begin(), edges.ids.end(), e.edge_id) - edges.ids.begin()));
     }
-    parent_lists.push_back(std::move(listed));
-  }
-  for (const Cell& cell : cells) {
-    ViewRegion region;
-    region.polygon.vertices = cell.ring;
+  });
+  const size_t first = regions_.size();
+  regions_.resize(first + cells.size());
+  ForEach(cells.size(), options.threads, occluders, [&](size_t i, const StoreyOccluders& own) {
+    ViewRegion& region = regions_[first + i];
+    region.polygon.vertices = cells[i].ring;
     region.storey = s;
-    region.visible = VisibilityList(cell.ring, model, edges, parent_lists[cell.parent], occluders,
+    region.visible = VisibilityList(cells[i].ring, model, edges, parent_lists[cells[i].parent], own,
                                     options.hidden_margin);
-    regions_.push_back(std::move(region));
-  }
+  });
 }
 
 }  // namespace linetrack

@@ -72,6 +72,9 @@ struct ViewInvariantRegionsOptions {
   // An edge counts as hidden only when the occluders block every sight line to it by at least
   // this much (metres); keeps the lists conservative against rounding and grazing sight lines.
   double hidden_margin = 1e-3;
+  // Threads computing the regions' visibility lists (0: one per hardware thread). The lists do
+  // not depend on it.
+  int threads = 0;
 
   bool Check(std::string* why) const;
 };

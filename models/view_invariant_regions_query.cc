@@ -1,5 +1,6 @@
 // Queries of the view-invariant regions, and the bearing half-width of a camera's image.
 #include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -9,6 +10,7 @@
 #include "models/errors.h"
 #include "models/free_space.h"
 #include "models/robot_pose.h"
+#include "models/text_format.h"
 #include "models/view_invariant_regions.h"
 
 namespace linetrack {
@@ -42,12 +44,6 @@ bool DiskBearings(const Segment2& footprint, const Eigen::Vector2d& centre, doub
   *arc_centre = reference + 0.5 * (lo + hi);
   *arc_half = 0.5 * (hi - lo);
   return true;
-}
-
-std::string Fixed(double value, int digits = 2) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
-  return buffer;
 }
 
 }  // namespace

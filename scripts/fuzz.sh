@@ -9,6 +9,11 @@ fuzz_dir="$build_dir/tests/fuzz"
 declare -A seeds=(
   [cao_fuzzer]="tests/data/cao_malformed models"
   [import_fuzzer]="tests/data/import_seeds"
+  [camera_fuzzer]="tests/data/camera_seeds"
+  [trajectory_fuzzer]="tests/data/trajectory_seeds"
+  [pose_file_fuzzer]="tests/data/pose_seeds"
+  [angles_fuzzer]="tests/data/angles_seeds"
+  [batch_fuzzer]="tests/data/batch_seeds"
 )
 for name in "${!seeds[@]}"; do
   fuzzer="$fuzz_dir/$name"

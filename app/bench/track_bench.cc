@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "models/errors.h"
+#include "models/text_format.h"
 #include "tracking/capture/video_source.h"
 #include "tracking/tracker/edge_tracker.h"
 #include "tracking/tracker/pose_file.h"
@@ -22,10 +23,6 @@ namespace linetrack::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // CPU time of the calling thread (milliseconds): robust to other processes on a shared machine.
 double ThreadCpuMs() {

@@ -78,8 +78,9 @@ MountBenchRun RunSeed(const BenchMountCommandOptions& opt, const CameraIntrinsic
   std::vector<PatternDetection> detections;
   for (const cv::Mat& image : views.images)
     detections.push_back(DetectPattern(image, opt.mount.pattern, opt.mount.detection));
-  run.mount =
-      CalibrateMountFromDetections(views.names, views.angles, detections, camera, opt.mount);
+  MountCalibrationOptions options = opt.mount;
+  options.distortion = views.distortion;
+  run.mount = CalibrateMountFromDetections(views.names, views.angles, detections, camera, options);
   const Eigen::Isometry3d truth =
       MovedPose(GeometryOf(HeadModel::kPtu46).tilt_from_camera, run.bracket);
   if (run.mount.ok()) {

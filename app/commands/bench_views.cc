@@ -23,6 +23,7 @@
 #include "models/errors.h"
 #include "models/statistics.h"
 #include "models/synth/synthetic_scenes.h"
+#include "models/text_format.h"
 
 namespace linetrack::app {
 namespace {
@@ -38,11 +39,6 @@ struct BenchViewsOptions {
   bool render_db = false;
   std::string out_path;
 };
-
-double Milliseconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
-}
 
 // A query: a rendered view at a random pose with its detected lines and their true edge ids.
 struct Query {
@@ -131,7 +127,7 @@ std::string RetrievalRow(const std::vector<Query>& queries, const ViewDatabase& 
   for (const Query& q : queries) {
     const auto start = std::chrono::steady_clock::now();
     const std::vector<RetrievedView> ranked = RetrieveViews(q.lines, db, {});
-    ms.push_back(Milliseconds(start));
+    ms.push_back(MillisecondsSince(start));
     if (ranked.empty()) {
       ++none;
       continue;
@@ -174,7 +170,7 @@ std::string PositioningRow(const std::vector<Query>& queries, const ViewDatabase
   for (const Query& q : queries) {
     const auto start = std::chrono::steady_clock::now();
     const ViewPositioning r = LocalizeFromViews(q.lines, db, {});
-    ms.push_back(Milliseconds(start));
+    ms.push_back(MillisecondsSince(start));
     if (!r.found) continue;
     ++found;
     const double e = std::hypot(r.pose.x - q.truth.x, r.pose.y - q.truth.y);
@@ -301,7 +297,7 @@ int RunBenchViews(const BenchViewsOptions& opt) {
   if (!s.grid.Check(&why)) throw InputError("--grid/--height/--tilt: " + why);
   const auto start = std::chrono::steady_clock::now();
   const ViewDatabase db = BuildDatabase(s, opt);
-  spdlog::info("{} key views built in {:.1f} s", db.views.size(), Milliseconds(start) / 1000.0);
+  spdlog::info("{} key views built in {:.1f} s", db.views.size(), MillisecondsSince(start) / 1000.0);
   std::ostringstream t;
   t << db.views.size() << " key views of " << opt.model_path << " ("
     << (opt.render_db ? "rendered, detected lines" : "projected edges") << ", grid " << opt.grid

@@ -53,6 +53,7 @@ struct MountInputs {
   std::optional<cv::Mat> floor;
   std::string floor_name;
   HeadAngles floor_angles;
+  DistortionModel distortion = DistortionModel::kKud;  // of the images (MountViews)
 };
 
 HeadAngles ParseAngles(const std::string& text, const std::string& flag) {
@@ -175,6 +176,7 @@ void GrabLive(const CalibrateMountCommandOptions& opt, const CameraIntrinsics& c
   in->names = std::move(views.names);
   in->images = std::move(views.images);
   in->angles = std::move(views.angles);
+  in->distortion = views.distortion;
 }
 
 void PrintResult(const MountCalibration& m, const std::optional<FloorCalibration>& floor) {
@@ -232,6 +234,7 @@ int RunCalibrateMount(CalibrateMountCommandOptions opt) {
   std::vector<PatternDetection> detections;
   for (const cv::Mat& image : in.images)
     detections.push_back(DetectPattern(image, opt.mount.pattern, opt.mount.detection));
+  opt.mount.distortion = in.distortion;
   const MountCalibration mount =
       CalibrateMountFromDetections(in.names, in.angles, detections, camera, opt.mount);
   if (mount.status == MountStatus::kPatternNeverFound ||

@@ -18,6 +18,7 @@
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/lines/line_extractor.h"
 #include "models/errors.h"
+#include "models/text_format.h"
 #include "tracking/integrity/image_pose_check.h"
 #include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/relocalizer.h"
@@ -105,11 +106,6 @@ LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   return options;
 }
 
-double Milliseconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
-}
-
 int RunBatch(const LocalizeOptions& opt) {
   std::ifstream in(opt.batch_path);
   std::error_code ec;
@@ -136,14 +132,14 @@ int RunBatch(const LocalizeOptions& opt) {
         const auto start = std::chrono::steady_clock::now();
         const GlobalResult result = global.Localize({c.problem.lines, z, c.problem.tilt});
         found += result.found ? 1 : 0;
-        std::cout << GlobalResultToJson(id, result, Milliseconds(start), &model).dump() << "\n";
+        std::cout << GlobalResultToJson(id, result, MillisecondsSince(start), &model).dump() << "\n";
         continue;
       }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
       c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
       const auto start = std::chrono::steady_clock::now();
       const LocalizationResult result = localizer.Localize(c.problem);
-      const double ms = Milliseconds(start);
+      const double ms = MillisecondsSince(start);
       found += result.found ? 1 : 0;
       std::cout << ResultToJson(id, result, ms, cache.Model(c.model_path).model.get()).dump()
                 << "\n";
@@ -250,7 +246,7 @@ int RunSingle(const LocalizeOptions& opt) {
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
-  const double ms = Milliseconds(start);
+  const double ms = MillisecondsSince(start);
   std::optional<PoseUncertainty> integrity;
   if (image && result.found) {
     integrity = CheckAnswer(opt, *image, problem, result, integrity_options);

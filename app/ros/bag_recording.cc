@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <map>
 
 #include "app/ros/ros_geometry.h"
@@ -24,12 +25,6 @@ namespace {
 double StampOf(const ros::Time& header, const ros::Time& recorded) {
   return header.isZero() ? recorded.toSec() : header.toSec();
 }
-
-// The head's angles over time (pan, tilt), from joint states.
-struct JointReading {
-  double t = 0.0;
-  double pan = 0.0, tilt = 0.0;
-};
 
 // The images of one topic, in the bag's order.
 class BagFrames : public FrameSource {
@@ -107,7 +102,7 @@ class RosBagRecording : public Recording {
   std::unique_ptr<BagFrames> frames_;
   double frame_rate_ = 30.0;
   std::vector<StampedOdometry> odometry_;
-  std::vector<JointReading> joints_;
+  std::vector<StampedHeadAngles> joints_;
   std::vector<PriorRecord> priors_;
   std::optional<CameraIntrinsics> camera_;
   std::unique_ptr<rosbag::Bag> out_;
@@ -166,7 +161,7 @@ void RosBagRecording::ReadReadings() {
   }
   for (const auto& [recorded, msg] :
        ReadAll<sensor_msgs::JointState>(bag_, options_.joint_states_topic)) {
-    JointReading reading{StampOf(msg->header.stamp, recorded), 0.0, options_.tilt};
+    StampedHeadAngles reading{StampOf(msg->header.stamp, recorded), 0.0, options_.tilt};
     for (size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i) {
       if (msg->name[i] == options_.pan_joint) reading.pan = msg->position[i];
       if (msg->name[i] == options_.tilt_joint) reading.tilt = msg->position[i];
@@ -174,7 +169,7 @@ void RosBagRecording::ReadReadings() {
     joints_.push_back(reading);
   }
   std::sort(joints_.begin(), joints_.end(),
-            [](const JointReading& a, const JointReading& b) { return a.t < b.t; });
+            [](const StampedHeadAngles& a, const StampedHeadAngles& b) { return a.t < b.t; });
   // Every image once: their stamps (the frame rate, the first frame where --prior holds), and a
   // truncated or corrupt chunk found before any output is written.
   std::vector<double> stamps;
@@ -206,25 +201,12 @@ void RosBagRecording::ReadReadings() {
 
 CameraMount RosBagRecording::MountAt(double t) const {
   CameraMount mount{options_.height, 0.0, options_.tilt};
-  if (joints_.empty()) return mount;
-  const JointReading* reading = nullptr;
-  JointReading between;
-  if (t <= joints_.front().t) {
-    reading = &joints_.front();
-  } else if (t >= joints_.back().t) {
-    reading = &joints_.back();
-  } else {
-    const auto after =
-        std::upper_bound(joints_.begin(), joints_.end(), t,
-                         [](double time, const JointReading& j) { return time < j.t; });
-    const JointReading& a = *(after - 1);
-    const JointReading& b = *after;
-    const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
-    between = {t, a.pan + s * (b.pan - a.pan), a.tilt + s * (b.tilt - a.tilt)};
-    reading = &between;
-  }
-  mount.pan = reading->pan;
-  mount.tilt = reading->tilt;
+  // The nearest reading however far: a bag's joint states start and end with its images.
+  const std::optional<StampedHeadAngles> angles =
+      HeadAnglesAt(joints_, t, std::numeric_limits<double>::infinity());
+  if (!angles) return mount;
+  mount.pan = angles->pan;
+  mount.tilt = angles->tilt;
   return mount;
 }
 

@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -32,7 +33,10 @@ struct BenchRosOptions {
   int frames = 100;
   double rate = 0.0;  // images per second; 0: paced
   double height = 1.3, tilt_deg = 5.0;
+  std::string head = "fixed";  // the node's ~head: fixed (--height, --tilt) or tf (base -> camera)
 };
+
+constexpr const char* kCameraFrame = "camera_optical";
 
 struct Drive {
   std::vector<SequenceFrame> frames;
@@ -56,6 +60,7 @@ Drive RenderDrive(const BenchRosOptions& opt) {
     const vpImage<unsigned char> image = renderer.Render(d.frames[i].cam_from_world, i);
     sensor_msgs::Image msg;
     msg.header.stamp = ros::Time(1.0 + d.frames[i].t);
+    msg.header.frame_id = kCameraFrame;
     msg.width = image.getWidth();
     msg.height = image.getHeight();
     msg.encoding = "mono8";
@@ -86,8 +91,24 @@ int RunBenchRos(const BenchRosOptions& opt) {
   RosNodeOptions options;
   options.model = opt.model;
   options.camera = opt.camera;
-  options.height = opt.height;
-  options.tilt_deg = opt.tilt_deg;
+  options.head = opt.head;
+  if (opt.head == "fixed") {
+    options.height = opt.height;
+    options.tilt_deg = opt.tilt_deg;
+  }
+  ros::Publisher tf_static_pub = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
+  if (opt.head == "tf") {  // the drive's mount, as a robot's URDF would give it
+    CameraMount mount;
+    mount.height = opt.height;
+    mount.tilt = DegToRad(opt.tilt_deg);
+    geometry_msgs::TransformStamped base_to_camera;
+    base_to_camera.header.frame_id = options.base_frame;
+    base_to_camera.child_frame_id = kCameraFrame;
+    base_to_camera.transform = ToTransformMsg(BaseFromCamera(mount));
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(base_to_camera);
+    tf_static_pub.publish(tf);
+  }
   RosNode node(options, nh, node_nh);
   ros::AsyncSpinner spinner(2);
   spinner.start();
@@ -99,8 +120,12 @@ int RunBenchRos(const BenchRosOptions& opt) {
   ros::Publisher odom_pub = nh.advertise<nav_msgs::Odometry>("odom", 1000);
   ros::Publisher initial_pub =
       nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 1, true);
-  WaitFor([&] { return status_sub.getNumPublishers() > 0 && image_pub.getNumSubscribers() > 0; },
-          30.0);
+  WaitFor(
+      [&] {
+        return status_sub.getNumPublishers() > 0 && image_pub.getNumSubscribers() > 0 &&
+               (opt.head != "tf" || tf_static_pub.getNumSubscribers() > 0);
+      },
+      30.0);
   geometry_msgs::PoseWithCovarianceStamped initial;
   initial.header.frame_id = "map";
   initial.header.stamp = drive.images.front().header.stamp;
@@ -133,7 +158,8 @@ int RunBenchRos(const BenchRosOptions& opt) {
   std::cout << "bench ros: " << done.received << " images ("
             << (opt.rate > 0.0 ? std::to_string(opt.rate) + " /s" : std::string("paced")) << "), "
             << done.dropped << " dropped, " << done.processed << " tracked, " << done.with_pose
-            << " poses on ~pose, " << done.degraded << " on ~pose_degraded\n";
+            << " poses on ~pose, " << done.degraded << " on ~pose_degraded, " << done.no_mount
+            << " without a camera mount (head " << opt.head << ")\n";
   PrintQuantiles("tracking step", done.track_ms);
   PrintQuantiles("taken to pose published, beyond the tracking step", done.overhead_ms);
   PrintQuantiles("waiting for the worker after arrival", done.wait_ms);
@@ -153,6 +179,11 @@ void AddBenchRos(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--nav", opt->nav, "Navigable-area sidecar (.nav.json) for the drive");
   cmd->add_option("--frames", opt->frames, "Frames of the drive")->capture_default_str();
   cmd->add_option("--rate", opt->rate, "Images per second (0: the next once the last is done)")
+      ->capture_default_str();
+  cmd->add_option("--head", opt->head,
+                  "The node's camera mount: fixed (--height, --tilt) or tf (a static TF "
+                  "base_link -> camera_optical)")
+      ->check(CLI::IsMember({"fixed", "tf"}))
       ->capture_default_str();
   cmd->callback([opt, action] { *action = [opt] { return RunBenchRos(*opt); }; });
 }

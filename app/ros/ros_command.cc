@@ -53,7 +53,8 @@ int RunRos(RosCommandOptions opt) {
   const RosNodeStats stats = node.Stats();
   std::cout << "ros: " << stats.received << " images, " << stats.dropped << " dropped, "
             << stats.processed << " tracked, " << stats.with_pose << " poses on ~pose, "
-            << stats.degraded << " on ~pose_degraded";
+            << stats.degraded << " on ~pose_degraded, " << stats.no_mount
+            << " without a camera mount";
   if (!stats.overhead_ms.empty()) {
     std::cout << "; beyond the tracking step median " << QuantileNearestRank(stats.overhead_ms, 0.5)
               << " ms, p95 " << QuantileNearestRank(stats.overhead_ms, 0.95)
@@ -70,7 +71,8 @@ void AddRos(CLI::App& cli, CommandAction* action) {
   auto opt = std::make_shared<RosCommandOptions>();
   CLI::App* cmd = cli.add_subcommand(
       "ros",
-      "ROS 1 node with AMCL's conventions: images, odometry, joint states and initialpose in; "
+      "ROS 1 node with AMCL's conventions: images, odometry, joint states or TF and initialpose "
+      "in; "
       "~pose (PoseWithCovarianceStamped of the base in the map), map -> odom on /tf, ~status, "
       "diagnostics and ~overlay out (docs/ros.md). Flags override the parameters (~model, ...); "
       "remappings as name:=value");
@@ -87,10 +89,15 @@ void AddRos(CLI::App& cli, CommandAction* action) {
   flag("--map-frame", "map_frame", &o.map_frame, "Map frame (~map_frame, default map)");
   flag("--odom-frame", "odom_frame", &o.odom_frame, "Odometry frame (~odom_frame, default odom)");
   flag("--base-frame", "base_frame", &o.base_frame, "Base frame (~base_frame, default base_link)");
-  flag("--height", "height", &o.height, "Camera height above the base's origin, metres (~height)");
+  flag("--camera-frame", "camera_frame", &o.camera_frame,
+       "Camera frame for TF (~camera_frame, default the image header's frame_id)");
+  flag("--head", "head", &o.head,
+       "Head angles from: auto (joint_states when a joint is named, else TF base -> camera when "
+       "TF links them, else --height/--tilt), joint_states, tf or fixed (~head, default auto)");
+  flag("--height", "height", &o.height,
+       "Camera height above the base's origin, metres, without TF (~height)");
   flag("--tilt", "tilt", &o.tilt_deg,
-       "Camera tilt below the horizontal without a tilt joint, "
-       "degrees (~tilt)");
+       "Camera tilt below the horizontal without a tilt joint or TF, degrees (~tilt)");
   flag("--pan-joint", "pan_joint", &o.pan_joint, "Pan joint in joint_states (~pan_joint)");
   flag("--tilt-joint", "tilt_joint", &o.tilt_joint, "Tilt joint in joint_states (~tilt_joint)");
   flag("--alert-limit", "alert_limit", &o.integrity.alert_limit,

@@ -9,8 +9,9 @@
 
 namespace linetrack::app {
 bool CameraMount::Check(std::string* why) const {
-  if (!std::isfinite(height) || !std::isfinite(pan) || !std::isfinite(tilt)) {
-    *why = "camera mount: height, pan and tilt must be finite";
+  if (!std::isfinite(height) || !std::isfinite(pan) || !std::isfinite(tilt) || !std::isfinite(x) ||
+      !std::isfinite(y) || !std::isfinite(roll)) {
+    *why = "camera mount: its position and angles must be finite";
     return false;
   }
   if (std::abs(tilt) >= DegToRad(89.0)) {
@@ -22,9 +23,25 @@ bool CameraMount::Check(std::string* why) const {
 
 Eigen::Isometry3d BaseFromCamera(const CameraMount& mount) {
   Eigen::Isometry3d base_from_cam = Eigen::Isometry3d::Identity();
-  base_from_cam.linear() = CamFromWorldRotation(mount.pan, mount.tilt).transpose();
-  base_from_cam.translation() = Eigen::Vector3d(0.0, 0.0, mount.height);
+  base_from_cam.linear() = CamFromWorldRotation(mount.pan, mount.tilt).transpose() *
+                           Eigen::AngleAxisd(mount.roll, Eigen::Vector3d::UnitZ());
+  base_from_cam.translation() = Eigen::Vector3d(mount.x, mount.y, mount.height);
   return base_from_cam;
+}
+
+CameraMount MountOfBaseFromCamera(const Eigen::Isometry3d& base_from_cam) {
+  const Eigen::Vector3d f = base_from_cam.linear().col(2);
+  const Eigen::Vector3d image_x = base_from_cam.linear().col(0);
+  CameraMount mount;
+  mount.pan = std::atan2(f.y(), f.x());
+  mount.tilt = -std::asin(std::clamp(f.z(), -1.0, 1.0));
+  // The level frame of the optical axis: rows r (image x) and d (image y) at zero roll.
+  const Eigen::Matrix3d level = CamFromWorldRotation(mount.pan, mount.tilt);
+  mount.roll = std::atan2(image_x.dot(level.row(1)), image_x.dot(level.row(0)));
+  mount.x = base_from_cam.translation().x();
+  mount.y = base_from_cam.translation().y();
+  mount.height = base_from_cam.translation().z();
+  return mount;
 }
 
 Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose) {
@@ -40,8 +57,10 @@ Pose3Dof PlanarOf(const Eigen::Isometry3d& pose) {
 }
 
 RobotPose CameraPrior(const Pose3Dof& map_base, const CameraMount& mount) {
-  // The optical centre is above the base's origin: same x, y.
-  return RobotPose{map_base.x, map_base.y, WrapAngle(map_base.heading + mount.pan), mount.height,
+  const Eigen::Vector2d centre =
+      Eigen::Vector2d(map_base.x, map_base.y) +
+      Eigen::Rotation2Dd(map_base.heading) * Eigen::Vector2d(mount.x, mount.y);
+  return RobotPose{centre.x(), centre.y(), WrapAngle(map_base.heading + mount.pan), mount.height,
                    mount.tilt};
 }
 
@@ -64,29 +83,59 @@ std::optional<Matrix6d> RosCovarianceOf(const PoseUncertainty& uncertainty,
   return Matrix6d(0.5 * (c + c.transpose()));
 }
 
+namespace {
+
+// The readings a <= b around time t (sorted by .t) and s = (t - a.t) / (b.t - a.t): b = a and
+// s = 0 before the first or after the last reading, when it is within max_gap of t; nullopt
+// otherwise.
+template <typename Reading>
+struct Bracket {
+  const Reading& a;
+  const Reading& b;
+  double s;
+};
+
+template <typename Reading>
+std::optional<Bracket<Reading>> BracketAt(const std::vector<Reading>& readings, double t,
+                                          double max_gap) {
+  if (readings.empty()) return std::nullopt;
+  if (t <= readings.front().t || t >= readings.back().t) {
+    const Reading& end = t <= readings.front().t ? readings.front() : readings.back();
+    if (std::abs(end.t - t) > max_gap) return std::nullopt;
+    return Bracket<Reading>{end, end, 0.0};
+  }
+  const auto after = std::upper_bound(readings.begin(), readings.end(), t,
+                                      [](double time, const Reading& r) { return time < r.t; });
+  const Reading& a = *(after - 1);
+  const Reading& b = *after;
+  return Bracket<Reading>{a, b, b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0};
+}
+
+}  // namespace
+
 std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& readings, double t,
                                             double max_gap) {
-  if (readings.empty()) return std::nullopt;
-  if (t <= readings.front().t) {
-    if (readings.front().t - t > max_gap) return std::nullopt;
-    return readings.front().odom_from_base;
-  }
-  if (t >= readings.back().t) {
-    if (t - readings.back().t > max_gap) return std::nullopt;
-    return readings.back().odom_from_base;
-  }
-  const auto after = std::upper_bound(
-      readings.begin(), readings.end(), t,
-      [](double time, const StampedOdometry& reading) { return time < reading.t; });
-  const StampedOdometry& a = *(after - 1);
-  const StampedOdometry& b = *after;
-  const double s = b.t > a.t ? (t - a.t) / (b.t - a.t) : 0.0;
+  const auto bracket = BracketAt(readings, t, max_gap);
+  if (!bracket) return std::nullopt;
+  if (&bracket->a == &bracket->b) return bracket->a.odom_from_base;  // at an end
+  const Eigen::Isometry3d& a = bracket->a.odom_from_base;
+  const Eigen::Isometry3d& b = bracket->b.odom_from_base;
+  const double s = bracket->s;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() =
-      (1.0 - s) * a.odom_from_base.translation() + s * b.odom_from_base.translation();
-  const Eigen::Quaterniond qa(a.odom_from_base.linear()), qb(b.odom_from_base.linear());
+  pose.translation() = (1.0 - s) * a.translation() + s * b.translation();
+  const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
   pose.linear() = qa.slerp(s, qb).toRotationMatrix();
   return pose;
+}
+
+std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
+                                              double t, double max_gap) {
+  const auto bracket = BracketAt(readings, t, max_gap);
+  if (!bracket) return std::nullopt;
+  const StampedHeadAngles& a = bracket->a;
+  const StampedHeadAngles& b = bracket->b;
+  const double s = bracket->s;
+  return StampedHeadAngles{t, a.pan + s * (b.pan - a.pan), a.tilt + s * (b.tilt - a.tilt)};
 }
 
 SearchBounds BoundsFromCovariance(const Matrix6d& covariance, const RelocalizationOptions& limits,

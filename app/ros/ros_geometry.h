@@ -18,21 +18,29 @@ namespace linetrack::app {
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-// Where the camera sits on the base (base_link: x forward, y left, z up): its optical centre
-// `height` metres above the base's origin, turned by `pan` (radians, counter-clockwise from the
-// base's x) and tilted down by `tilt` (radians), roll zero. With a pan-tilt head, pan and tilt
-// are its joint angles; without one, pan 0 and the fixed tilt.
+// Where the camera sits on the base (base_link: x forward, y left, z up): its optical centre at
+// (x, y, height) metres in the base, turned by `pan` (radians, counter-clockwise from the base's
+// x), tilted down by `tilt` (radians) and rolled by `roll` (radians, about the optical axis, the
+// image's x towards its y). With a pan-tilt head, pan and tilt are its joint angles; without one,
+// pan 0 and the fixed tilt; from TF, all six (MountOfBaseFromCamera).
 struct CameraMount {
   double height = 0.0;
   double pan = 0.0;
   double tilt = 0.0;
+  double x = 0.0, y = 0.0;  // the optical centre ahead of and left of the base's origin (m)
+  double roll = 0.0;
 
   bool Check(std::string* why) const;
 };
 
-// base_from_cam of the mount (ViSP camera axes: x right, y down, z forward):
-// translation (0, 0, height), rotation CamFromWorldRotation(pan, tilt)^T.
+// base_from_cam of the mount (ViSP camera axes: x right, y down, z forward): translation
+// (x, y, height), rotation CamFromWorldRotation(pan, tilt)^T Rz(roll).
 Eigen::Isometry3d BaseFromCamera(const CameraMount& mount);
+
+// The mount of a base_from_cam (the inverse of BaseFromCamera, for |tilt| < 90 degrees): pan and
+// tilt from the optical axis f = R e_z (pan = atan2(f_y, f_x), tilt = -asin(f_z)), roll from the
+// image's x axis in the level frame of that axis.
+CameraMount MountOfBaseFromCamera(const Eigen::Isometry3d& base_from_cam);
 
 // A planar base pose (x, y, yaw about z) as an isometry of the plane z = 0.
 Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose);
@@ -41,7 +49,8 @@ Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose);
 Pose3Dof PlanarOf(const Eigen::Isometry3d& pose);
 
 // The camera's reading for the tracker from the base's planar pose in the map and the mount:
-// position of the optical centre, heading = base yaw + pan, height and tilt of the mount.
+// position of the optical centre (base + Rz(yaw) (x, y)), heading = base yaw + pan, height and
+// tilt of the mount (the tracker's camera has no roll).
 RobotPose CameraPrior(const Pose3Dof& map_base, const CameraMount& mount);
 
 // map_from_base of a tracked camera: (cam_from_map)^-1 base_from_cam^-1.
@@ -70,6 +79,18 @@ struct StampedOdometry {
 // at most max_gap seconds, else nullopt. `readings` sorted by time.
 std::optional<Eigen::Isometry3d> OdometryAt(const std::vector<StampedOdometry>& readings, double t,
                                             double max_gap);
+
+// A pan-tilt head's joint angles (radians) at a stamp (sensor_msgs/JointState).
+struct StampedHeadAngles {
+  double t = 0.0;  // seconds
+  double pan = 0.0, tilt = 0.0;
+};
+
+// The head's angles at time t: linear interpolation between the two readings around t; the first
+// or last reading when t is outside their range by at most max_gap seconds, else nullopt.
+// `readings` sorted by time.
+std::optional<StampedHeadAngles> HeadAnglesAt(const std::vector<StampedHeadAngles>& readings,
+                                              double t, double max_gap);
 
 // The matcher's first bounds from an initial pose's covariance (RViz's "2D Pose Estimate": 0.25
 // m^2 in x and y, 0.0685 rad^2 in yaw): sigma_scale times the largest position and yaw

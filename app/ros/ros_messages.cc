@@ -20,6 +20,15 @@ Eigen::Isometry3d ToIsometry(const geometry_msgs::Pose& pose) {
   return iso;
 }
 
+Eigen::Isometry3d ToIsometry(const geometry_msgs::Transform& transform) {
+  geometry_msgs::Pose pose;
+  pose.position.x = transform.translation.x;
+  pose.position.y = transform.translation.y;
+  pose.position.z = transform.translation.z;
+  pose.orientation = transform.rotation;
+  return ToIsometry(pose);
+}
+
 geometry_msgs::Pose ToPoseMsg(const Eigen::Isometry3d& pose) {
   geometry_msgs::Pose msg;
   const Eigen::Quaterniond q(pose.linear());

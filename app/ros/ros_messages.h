@@ -17,7 +17,9 @@
 
 namespace linetrack::app {
 
+// A pose or a transform (parent_from_child) as an isometry; an all-zero quaternion is identity.
 Eigen::Isometry3d ToIsometry(const geometry_msgs::Pose& pose);
+Eigen::Isometry3d ToIsometry(const geometry_msgs::Transform& transform);
 geometry_msgs::Pose ToPoseMsg(const Eigen::Isometry3d& pose);
 geometry_msgs::Transform ToTransformMsg(const Eigen::Isometry3d& pose);
 

@@ -24,6 +24,7 @@
 
 #include "app/cli_common.h"
 #include "app/replay_output.h"
+#include "app/ros/newest_only.h"
 #include "app/ros/ros_messages.h"
 #include "app/ros/ros_tracker.h"
 #include "models/errors.h"
@@ -51,16 +52,7 @@ void Param(const ros::NodeHandle& nh, const std::vector<std::string>& given, con
 
 void RosNodeOptions::Check() const {
   if (model.empty()) throw InputError("ros: no model: give --model or the parameter ~model");
-  if (!std::isfinite(height)) {
-    throw InputError("ros: no camera height: give --height or the parameter ~height");
-  }
-  CheckRange(height, 0.0, 100.0, "--height");
-  if (tilt_joint.empty()) {
-    if (!std::isfinite(tilt_deg)) {
-      throw InputError("ros: no tilt: give --tilt (or ~tilt), or a tilt joint (~tilt_joint)");
-    }
-    CheckRange(tilt_deg, -89.0, 89.0, "--tilt");
-  }
+  MountOptions().Check();
   integrity.Options();  // throws naming the flag
   CheckRange(transform_tolerance, 0.0, 10.0, "--transform-tolerance");
   CheckRange(odom_max_gap, 0.0, 10.0, "--odom-max-gap");
@@ -68,6 +60,20 @@ void RosNodeOptions::Check() const {
   for (const std::string* frame : {&map_frame, &odom_frame, &base_frame}) {
     if (frame->empty()) throw InputError("ros: frame names must not be empty");
   }
+}
+
+CameraMountSourceOptions RosNodeOptions::MountOptions() const {
+  CameraMountSourceOptions o;
+  o.head = ParseHeadSource(head);
+  o.height = height;
+  o.tilt = DegToRad(tilt_deg);
+  o.pan_joint = pan_joint;
+  o.tilt_joint = tilt_joint;
+  o.base_frame = base_frame;
+  o.camera_frame = camera_frame;
+  o.wait = odom_wait;
+  o.max_gap = odom_max_gap;
+  return o;
 }
 
 void ReadRosParameters(const ros::NodeHandle& nh, const std::vector<std::string>& given,
@@ -78,6 +84,8 @@ void ReadRosParameters(const ros::NodeHandle& nh, const std::vector<std::string>
   Param(nh, given, "map_frame", &o->map_frame);
   Param(nh, given, "odom_frame", &o->odom_frame);
   Param(nh, given, "base_frame", &o->base_frame);
+  Param(nh, given, "camera_frame", &o->camera_frame);
+  Param(nh, given, "head", &o->head);
   Param(nh, given, "height", &o->height);
   Param(nh, given, "tilt", &o->tilt_deg);
   Param(nh, given, "pan_joint", &o->pan_joint);
@@ -115,17 +123,16 @@ struct RosNode::Impl {
   RosTrackerOptions tracker_options;
   std::unique_ptr<RosTracker> tracker;  // worker thread only
   std::unique_ptr<OcclusionTester> occlusion;
+  std::unique_ptr<CameraMountSource> mount_source;
   // From the last tracking pose (worker thread only); cleared by a new initial pose.
   std::optional<Eigen::Isometry3d> map_from_odom;
 
   mutable std::mutex mutex;  // guards everything below
   std::condition_variable wake;
-  std::optional<PendingImage> pending;
+  NewestOnly<PendingImage> pending;
   std::optional<CameraIntrinsics> camera_from_info;
   std::optional<PendingStart> start;
   std::deque<StampedOdometry> odometry;
-  double pan = 0.0, tilt = 0.0;
-  bool have_pan = false, have_tilt = false;
   bool stop = false;
   RosNodeStats stats;
   RosStatus last_status = RosStatus::kRelocalising;
@@ -144,7 +151,6 @@ struct RosNode::Impl {
   bool OnGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool EnsureTracker();
-  CameraMount MountNow() const;
   void ApplyStart();
   void Process(const PendingImage& image, Clock::time_point taken);
   void Publish(const TrackedFrame& out, const std_msgs::Header& header,
@@ -158,6 +164,7 @@ void RosNode::Impl::Setup() {
   tracker_options.settings =
       options.settings.empty() ? base : ReadTrackerSettings(options.settings, base);
   tracker_options.sequence.integrity = options.integrity.Options();
+  mount_source = std::make_unique<CameraMountSource>(options.MountOptions(), nh);
   if (!options.camera.empty()) {
     tracker_options.camera = LoadCamera(options.camera);
     if (tracker_options.camera.width <= 0) {
@@ -169,7 +176,9 @@ void RosNode::Impl::Setup() {
   }
   image_sub = it.subscribe("image", 2, &Impl::OnImage, this);
   odom_sub = nh.subscribe("odom", 100, &Impl::OnOdometry, this);
-  joints_sub = nh.subscribe("joint_states", 100, &Impl::OnJoints, this);
+  if (options.MountOptions().Resolved() == HeadSource::kJointStates) {
+    joints_sub = nh.subscribe("joint_states", 100, &Impl::OnJoints, this);
+  }
   initial_sub = nh.subscribe("initialpose", 2, &Impl::OnInitialPose, this);
   pose_pub = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 10);
   degraded_pub = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose_degraded", 10);
@@ -183,8 +192,7 @@ void RosNode::Impl::Setup() {
 void RosNode::Impl::OnImage(const sensor_msgs::ImageConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex);
   ++stats.received;
-  if (pending) ++stats.dropped;  // the waiting image is older: it goes
-  pending = PendingImage{msg, Clock::now()};
+  if (pending.Put(PendingImage{msg, Clock::now()})) ++stats.dropped;  // the older one went
   wake.notify_one();
 }
 
@@ -209,16 +217,7 @@ void RosNode::Impl::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
 }
 
 void RosNode::Impl::OnJoints(const sensor_msgs::JointStateConstPtr& msg) {
-  std::lock_guard<std::mutex> lock(mutex);
-  for (size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i) {
-    if (!options.pan_joint.empty() && msg->name[i] == options.pan_joint) {
-      pan = msg->position[i];
-      have_pan = true;
-    } else if (!options.tilt_joint.empty() && msg->name[i] == options.tilt_joint) {
-      tilt = msg->position[i];
-      have_tilt = true;
-    }
-  }
+  mount_source->OnJoints(*msg);
 }
 
 void RosNode::Impl::OnInitialPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
@@ -252,6 +251,8 @@ void RosNode::Impl::Diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("images processed", stats.processed);
   status.add("poses published", stats.with_pose);
   status.add("degraded poses published", stats.degraded);
+  status.add("images without a camera mount", stats.no_mount);
+  status.add("head angles from", mount_source->LastSource());
   if (!stats.track_ms.empty()) {
     status.add("tracking step median (ms)", QuantileNearestRank(stats.track_ms, 0.5));
     status.add("latency beyond tracking median (ms)", QuantileNearestRank(stats.overhead_ms, 0.5));
@@ -270,14 +271,6 @@ bool RosNode::Impl::EnsureTracker() {
   tracker = std::make_unique<RosTracker>(tracker_options);
   occlusion = std::make_unique<OcclusionTester>(tracker->model());
   return true;
-}
-
-CameraMount RosNode::Impl::MountNow() const {
-  CameraMount mount;
-  mount.height = options.height;
-  mount.tilt = have_tilt ? tilt : DegToRad(options.tilt_deg);
-  mount.pan = have_pan ? pan : 0.0;
-  return mount;
 }
 
 void RosNode::Impl::ApplyStart() {
@@ -317,19 +310,28 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
                        tracker_options.camera.height);
     return;
   }
-  ApplyStart();
   TrackerInput input;
   input.t = header.stamp.toSec();
+  std::string why;
+  const std::optional<CameraMount> mount = mount_source->At(header, &why);
+  if (!mount) {
+    ROS_ERROR_THROTTLE(10.0, "linetrack: no camera mount: %s", why.c_str());
+    std::lock_guard<std::mutex> lock(mutex);
+    ++stats.no_mount;
+    last_note = "no camera mount: " + why;
+    return;
+  }
+  input.mount = *mount;
   std::optional<Eigen::Isometry3d> odom;
   {
     std::unique_lock<std::mutex> lock(mutex);
     wake.wait_for(lock, std::chrono::duration<double>(options.odom_wait),
                   [&] { return stop || odometry.empty() || odometry.back().t >= input.t; });
-    input.mount = MountNow();
     const std::vector<StampedOdometry> readings(odometry.begin(), odometry.end());
     odom = OdometryAt(readings, input.t, options.odom_max_gap);
   }
   if (odom) input.odom_base = PlanarOf(*odom);
+  ApplyStart();  // after the odometry's wait: the initial pose is anchored to its reading
   const TrackedFrame out = tracker->Process(grey, input);
   Publish(out, header, odom);
   const double busy_ms = std::chrono::duration<double, std::milli>(Clock::now() - taken).count();
@@ -415,9 +417,10 @@ void RosNode::Run() {
     std::optional<Impl::PendingImage> image;
     {
       std::unique_lock<std::mutex> lock(m.mutex);
-      m.wake.wait_for(lock, std::chrono::milliseconds(100), [&] { return m.pending || m.stop; });
+      m.wake.wait_for(lock, std::chrono::milliseconds(100),
+                      [&] { return m.pending.waiting() || m.stop; });
       if (m.stop) break;
-      image.swap(m.pending);
+      image = m.pending.Take();
     }
     const Clock::time_point taken = Clock::now();
     if (image && m.EnsureTracker()) m.Process(*image, taken);

@@ -1,10 +1,11 @@
 // `linetrack ros`: the ROS 1 node, with the conventions of ROS's laser localiser AMCL. Subscribes
 // (relative names, remappable) image (image_transport), camera_info (without --camera), odom,
-// joint_states (pan and tilt joints) and initialpose; publishes ~pose (PoseWithCovarianceStamped
-// of the base in the map, stamped with the image's stamp; tracking poses only) and map -> odom on
-// /tf from them (never map -> base), ~pose_degraded (the other poses, with their covariance),
-// ~status, diagnostics and ~overlay; serves ~global_localization. Images arriving while one is
-// tracked replace the waiting one (the oldest is dropped and counted): it never lags the stream.
+// the head's angles from joint_states (pan and tilt joints) or TF base -> camera, and initialpose;
+// publishes ~pose (PoseWithCovarianceStamped of the base in the map, stamped with the image's
+// stamp; tracking poses only) and map -> odom on /tf from them (never map -> base), ~pose_degraded
+// (the other poses, with their covariance), ~status, diagnostics and ~overlay; serves
+// ~global_localization. Images arriving while one is tracked replace the waiting one (the oldest is
+// dropped and counted): it never lags the stream.
 #pragma once
 
 #include <ros/ros.h>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "app/integrity_output.h"
+#include "app/ros/camera_mount_source.h"
 #include "app/ros/ros_geometry.h"
 
 namespace linetrack::app {
@@ -27,8 +29,11 @@ struct RosNodeOptions {
   std::string camera;    // ViSP camera XML; empty: from camera_info
   std::string settings;  // ViSP tracker XML
   std::string map_frame = "map", odom_frame = "odom", base_frame = "base_link";
+  std::string camera_frame;  // empty: the image header's frame_id
+  // The head's angles: auto, joint_states, tf or fixed (HeadSource).
+  std::string head = "auto";
   double height = std::numeric_limits<double>::quiet_NaN();    // camera above the base (m)
-  double tilt_deg = std::numeric_limits<double>::quiet_NaN();  // without a tilt joint
+  double tilt_deg = std::numeric_limits<double>::quiet_NaN();  // without a tilt joint or TF
   std::string pan_joint, tilt_joint;  // joint_states names; empty: no such joint
   // ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma: the integrity monitor's
   IntegrityFlags integrity;
@@ -41,10 +46,13 @@ struct RosNodeOptions {
 
   // Throws InputError naming the parameter when a value is out of range.
   void Check() const;
+  // The head's part of these options.
+  CameraMountSourceOptions MountOptions() const;
 };
 
 // Fills the options not given on the command line from the private parameters (~model,
-// ~camera, ~settings, ~map_frame, ~odom_frame, ~base_frame, ~height, ~tilt, ~pan_joint,
+// ~camera, ~settings, ~map_frame, ~odom_frame, ~base_frame, ~camera_frame, ~head, ~height,
+// ~tilt, ~pan_joint,
 // ~tilt_joint, ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma,
 // ~transform_tolerance, ~odom_max_gap, ~odom_wait). `given` names the
 // command-line flags given (without dashes, e.g. "model").
@@ -58,6 +66,7 @@ struct RosNodeStats {
   long processed = 0;
   long with_pose = 0;  // on ~pose (tracking)
   long degraded = 0;   // on ~pose_degraded
+  long no_mount = 0;   // not tracked: the camera's mount unknown at the stamp (TF)
   // The last frames' (at most 100000): the tracking step; the time from the worker taking the
   // image to its pose published, minus the tracking step (conversion, odometry, publishing); the
   // time the image waited for the worker after its arrival (the frame before it being tracked).

@@ -75,6 +75,8 @@ void RosTracker::Restart(const Pose3Dof& map_base, const std::optional<Pose3Dof>
                                                 options_.sequence);
   map_from_odom_ = odom_base ? PlanarIsometry(map_base) * PlanarIsometry(*odom_base).inverse()
                              : Eigen::Isometry3d::Identity();
+  unanchored_start_.reset();
+  if (!odom_base) unanchored_start_ = map_base;
   // Without odometry the prior stays where the initial pose put the base.
   if (!odom_base) sequence_->SetInitialPrior(map_base);
   had_pose_ = false;
@@ -85,6 +87,11 @@ TrackedFrame RosTracker::Process(const vpImage<unsigned char>& image, const Trac
   RobotReading reading;
   reading.height = input.mount.height;
   reading.tilt = input.mount.tilt;
+  if (input.odom_base && unanchored_start_) {  // the robot still where the initial pose put it
+    map_from_odom_ =
+        PlanarIsometry(*unanchored_start_) * PlanarIsometry(*input.odom_base).inverse();
+    unanchored_start_.reset();
+  }
   if (input.odom_base) {
     const Pose3Dof map_base = PlanarOf(map_from_odom_ * PlanarIsometry(*input.odom_base));
     reading.odometry = CameraPrior(map_base, input.mount).Planar();

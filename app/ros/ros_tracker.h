@@ -75,7 +75,8 @@ class RosTracker {
 
   // Starts over from a prior of the base (x, y, yaw in the map) with these matcher bounds: the
   // odometry given to Process() from now on is expressed in the frame where `map_base` holds
-  // at the odometry reading `odom_base` (both at the same instant).
+  // at the odometry reading `odom_base` (both at the same instant); without one, at the first
+  // reading Process() is given.
   void Restart(const Pose3Dof& map_base, const std::optional<Pose3Dof>& odom_base,
                const SearchBounds& bounds);
 
@@ -101,6 +102,7 @@ class RosTracker {
   // The odometry frame's pose in the map at the last Restart(): odometry readings are moved into
   // the map with it before they reach the tracker.
   Eigen::Isometry3d map_from_odom_ = Eigen::Isometry3d::Identity();
+  std::optional<Pose3Dof> unanchored_start_;  // a Restart() without odometry, until a reading
   bool had_pose_ = false;
 };
 

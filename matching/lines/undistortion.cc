@@ -5,25 +5,6 @@
 
 namespace linetrack {
 
-Eigen::Vector2d DistortedPixelOf(const CameraIntrinsics& camera, const Eigen::Vector2d& uv) {
-  if (!camera.has_distortion || camera.kdu == 0.0) return uv;
-  const double x = (uv.x() - camera.u0) / camera.px, y = (uv.y() - camera.v0) / camera.py;
-  const double rho_u = std::hypot(x, y);
-  if (rho_u == 0.0) return uv;
-  // Solve rho_d (1 + kdu rho_d^2) = rho_u; increasing in rho_d while 1 + 3 kdu rho_d^2 > 0.
-  double rho = rho_u;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    const double f = rho * (1.0 + camera.kdu * rho * rho) - rho_u;
-    const double slope = 1.0 + 3.0 * camera.kdu * rho * rho;
-    if (slope <= 1e-6) break;
-    const double step = f / slope;
-    rho -= step;
-    if (std::abs(step) < 1e-13) break;
-  }
-  const double scale = rho / rho_u;
-  return {camera.u0 + camera.px * x * scale, camera.v0 + camera.py * y * scale};
-}
-
 Segment2 UndistortSegment(const CameraIntrinsics& camera, const Segment2& distorted) {
   return {camera.Undistort(distorted.a), camera.Undistort(distorted.b)};
 }

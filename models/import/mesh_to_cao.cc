@@ -12,6 +12,9 @@
 namespace linetrack {
 namespace {
 
+// Points farther than this from the origin on an axis are refused (metres).
+constexpr double kMaxCoordinateM = 1e7;
+
 using Edge = std::pair<int, int>;  // undirected: first < second
 
 Edge Undirected(int a, int b) {
@@ -273,6 +276,26 @@ void KeepUsedPoints(const std::vector<Eigen::Vector3d>& points, CaoModel* cao) {
   }
 }
 
+// Throws InputError naming `source` unless every point is finite and within kMaxCoordinateM of
+// the origin on each axis (so that the welding cubes' integer indices cannot overflow) and every
+// index refers to a point.
+void CheckMesh(const ImportMesh& mesh, const std::string& source) {
+  for (const Eigen::Vector3d& p : mesh.points) {
+    if (!(p.cwiseAbs().maxCoeff() <= kMaxCoordinateM)) {
+      throw InputError(Located(source, 0, "a point is not finite or lies over 1e7 m out"));
+    }
+  }
+  const auto valid = [&](int i) { return i >= 0 && static_cast<size_t>(i) < mesh.points.size(); };
+  for (const std::array<int, 3>& t : mesh.triangles) {
+    if (!std::all_of(t.begin(), t.end(), valid))
+      throw InputError(Located(source, 0, "a triangle refers to a missing point"));
+  }
+  for (const std::array<int, 2>& l : mesh.lines) {
+    if (!std::all_of(l.begin(), l.end(), valid))
+      throw InputError(Located(source, 0, "a line refers to a missing point"));
+  }
+}
+
 }  // namespace
 
 bool MeshToCaoOptions::Check(std::string* why) const {
@@ -280,8 +303,8 @@ bool MeshToCaoOptions::Check(std::string* why) const {
     *why = "the feature angle must be in (0, 90) degrees";
     return false;
   }
-  if (!(merge_tolerance > 0.0 && merge_tolerance <= 0.1)) {
-    *why = "the merge tolerance must be in (0, 0.1] metres";
+  if (!(merge_tolerance >= 1e-9 && merge_tolerance <= 0.1)) {
+    *why = "the merge tolerance must be in [1e-9, 0.1] metres";
     return false;
   }
   if (!(coplanar_angle_deg > 0.0 && coplanar_angle_deg < feature_angle_deg)) {
@@ -346,6 +369,7 @@ CaoModel MeshToCao(const ImportMesh& mesh, const MeshToCaoOptions& options,
                    const std::string& source, MeshToCaoSummary* summary) {
   std::string why;
   if (!options.Check(&why)) throw InputError(Located(source, 0, why));
+  CheckMesh(mesh, source);
   MeshToCaoSummary unused;
   if (summary == nullptr) summary = &unused;
   *summary = MeshToCaoSummary();

@@ -10,12 +10,15 @@
 #include <sstream>
 
 #include "models/errors.h"
+#include "models/import/import_guards.h"
 
 namespace linetrack {
 namespace {
 
 // A model wider than this (metres) is almost certainly in millimetres read as metres.
 constexpr double kImplausibleExtentM = 1000.0;
+// More vertices than this are refused (the indices are ints).
+constexpr size_t kMaxImportPoints = size_t{1} << 30;
 
 std::string Extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -26,13 +29,17 @@ std::string Extension(const std::string& path) {
 
 // The triangles and lines of every mesh of the scene, node transforms applied (Assimp's
 // aiProcess_PreTransformVertices), scaled to metres and rotated to z up.
-ImportMesh MeshOfScene(const aiScene& scene, double scale, UpAxis up) {
+ImportMesh MeshOfScene(const aiScene& scene, double scale, UpAxis up, const std::string& path) {
   ImportMesh mesh;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh& in = *scene.mMeshes[m];
+    if (in.mNumVertices > kMaxImportPoints - mesh.points.size())
+      throw InputError(Located(path, 0, "over 2^30 vertices"));
     const int base = static_cast<int>(mesh.points.size());
     for (unsigned v = 0; v < in.mNumVertices; ++v) {
       const aiVector3D& p = in.mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw InputError(Located(path, 0, "a vertex coordinate is not a finite number"));
       // y up: (x, y, z) -> (x, -z, y), a rotation of +90 degrees about x.
       const Eigen::Vector3d q =
           up == UpAxis::kY ? Eigen::Vector3d(p.x, -p.z, p.y) : Eigen::Vector3d(p.x, p.y, p.z);
@@ -40,6 +47,10 @@ ImportMesh MeshOfScene(const aiScene& scene, double scale, UpAxis up) {
     }
     for (unsigned f = 0; f < in.mNumFaces; ++f) {
       const aiFace& face = in.mFaces[f];
+      for (unsigned k = 0; k < face.mNumIndices; ++k) {
+        if (face.mIndices[k] >= in.mNumVertices)
+          throw InputError(Located(path, 0, "a face refers to a vertex the file does not hold"));
+      }
       if (face.mNumIndices == 3) {
         mesh.triangles.push_back({base + static_cast<int>(face.mIndices[0]),
                                   base + static_cast<int>(face.mIndices[1]),
@@ -111,15 +122,17 @@ ImportedModel ImportModel(const std::string& path, const ModelImportOptions& opt
     model.notes.push_back("unit " + Metres(model.metres_per_unit) + " m" +
                           (options.metres_per_unit ? " (--unit)" : " (no unit in the file)"));
   }
+  CheckBeforeAssimp(path);
   Assimp::Importer importer;
   // Points and lines are kept (3D lines), polygons triangulated, the scene graph flattened.
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                  aiProcess_PreTransformVertices | aiProcess_SortByPType);
   if (scene == nullptr) {
     throw InputError(
         Located(path, 0, std::string("cannot import the model: ") + importer.GetErrorString()));
   }
-  const ImportMesh mesh = MeshOfScene(*scene, model.metres_per_unit, model.up);
+  const ImportMesh mesh = MeshOfScene(*scene, model.metres_per_unit, model.up, path);
   if (mesh.triangles.empty() && mesh.lines.empty())
     throw InputError(Located(path, 0, "the file holds no triangle or line"));
   Eigen::Vector3d lo = mesh.points.front(), hi = lo;

@@ -4,12 +4,14 @@
 // replay (frames.csv columns, covariance.jsonl, the summary's block, poses.txt tracking only, no
 // integrity failure against the truth), and --out-bag holds the tracking poses with their
 // covariance (the truth within its 99.9% region) and map -> odom, the others apart. Bad bags
-// (missing topic, wrong type, truncated, unindexed) exit 2 with one line and write nothing.
+// (missing topic, wrong type, truncated, unindexed) exit 2 with one line and write nothing. The
+// camera may come from the bag's camera_info instead of --camera.
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -27,6 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kCameraFile = kSource + "/tests/data/camera_wide.xml";
 
 constexpr int kFrames = 20;
 constexpr double kPanAmplitudeDeg = 10.0;
@@ -66,6 +69,9 @@ struct BagRun {
       joints.position = {drive.frames[i].pan, drive.frames[i].camera.tilt};
       out.write("/joint_states", stamp, joints);
       out.write("/camera/image_raw", stamp, test::ImageMsg(drive.images[i], stamp));
+      sensor_msgs::CameraInfo info = test::CameraInfoOf(ReadCameraXml(kCameraFile));
+      info.header.stamp = stamp;
+      out.write("/camera/camera_info", stamp, info);
     }
     std::vector<StampedPose> truth_poses;
     for (int i = 0; i < kFrames; ++i) {
@@ -83,15 +89,17 @@ const BagRun& TheRun() {
 
 class RosBagReplay : public test_support::CliTest {
  protected:
-  std::string Args(const fs::path& bag, const std::string& odom_topic, const fs::path& out) {
+  // The replay of `bag`; the camera from --camera unless `camera` names another source.
+  std::string Args(const fs::path& bag, const std::string& odom_topic, const fs::path& out,
+                   const std::string& camera = "--camera " + kCameraFile) {
     const Pose3Dof start = TheRun().drive.frames[0].base.Planar();
     return "replay --input " + bag.string() + " --image-topic /camera/image_raw --odom-topic " +
            odom_topic + " --joint-states-topic /joint_states --pan-joint head_pan --tilt-joint " +
            "head_tilt --height " + std::to_string(test::kSceneHeight) + " --model " + kSource +
-           "/models/hall.cao --camera " + kSource + "/tests/data/camera_wide.xml --prior " +
-           std::to_string(start.x) + "," + std::to_string(start.y) + "," +
-           std::to_string(RadToDeg(start.heading)) + " --no-overlay --out " + out.string() +
-           " --out-bag " + (out.string() + ".bag") + " --alert-limit " + kAlertLimit;
+           "/models/hall.cao " + camera + " --prior " + std::to_string(start.x) + "," +
+           std::to_string(start.y) + "," + std::to_string(RadToDeg(start.heading)) +
+           " --no-overlay --out " + out.string() + " --out-bag " + (out.string() + ".bag") +
+           " --alert-limit " + kAlertLimit;
   }
 
   void ExpectRejected(const fs::path& bag, const std::string& odom_topic,
@@ -194,6 +202,24 @@ TEST_F(RosBagReplay, PosesCarryTheBagsStampsAndMatchTheTruth) {
   EXPECT_EQ(n.tracking, tracking);
   EXPECT_EQ(n.degraded, degraded);
   EXPECT_EQ(n.transforms, tracking);
+}
+
+// The camera from the bag's camera_info (no --camera): the same poses within the tolerances.
+TEST_F(RosBagReplay, TheCameraFromTheBagsCameraInfo) {
+  const BagRun& run = TheRun();
+  const fs::path out = dir_ / "replay_info";
+  const test_support::CommandRun result =
+      Linetrack(Args(run.bag, "/robot/odom", out, "--camera-info-topic /camera/camera_info"));
+  ASSERT_EQ(result.code, 0) << result.err;
+  const std::vector<StampedPose> poses = ReadTum((out / "poses.txt").string());
+  EXPECT_GE(static_cast<int>(poses.size()), kFrames - kMaxFramesNotTracking);
+  for (const StampedPose& pose : poses) {
+    const int i = static_cast<int>(std::lround((pose.t - test::kSceneStart) / test::kSceneStep));
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, kFrames);
+    const Eigen::Vector3d truth = run.drive.frames[i].cam_from_world.inverse().translation();
+    EXPECT_LT((pose.world_from_cam.translation() - truth).norm(), kPositionTolM) << "frame " << i;
+  }
 }
 
 TEST_F(RosBagReplay, BadBagsExitTwoWithOneLineAndWriteNothing) {

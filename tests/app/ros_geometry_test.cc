@@ -7,6 +7,7 @@
 
 #include <array>
 
+#include "app/ros/newest_only.h"
 #include "app/ros/ros_tracker.h"
 #include "models/geometry.h"
 
@@ -30,6 +31,47 @@ TEST(RosGeometry, TheMountedCameraSeesWhatTheRobotPoseSays) {
   EXPECT_TRUE(MapFromBase(s.cam_from_map, s.mount).isApprox(s.map_from_base, kExact));
   const Pose3Dof planar = PlanarOf(s.map_from_base);
   EXPECT_NEAR(planar.heading, s.base.heading, kExact);
+}
+
+// A camera 0.2 m ahead of and 0.05 m right of the base's origin (a head's offset from TF): the
+// tracker's prior is at its optical centre, and the tracked camera gives the base back.
+TEST(RosGeometry, AnOffsetCameraSeesWhatTheRobotPoseSays) {
+  Scene s;
+  s.mount.x = 0.2;
+  s.mount.y = -0.05;
+  s.cam_from_map = (s.map_from_base * BaseFromCamera(s.mount)).inverse();
+  EXPECT_TRUE(s.cam_from_map.isApprox(CamFromWorld(CameraPrior(s.base, s.mount)), kExact));
+  EXPECT_TRUE(MapFromBase(s.cam_from_map, s.mount).isApprox(s.map_from_base, kExact));
+  // The optical centre in the map, by hand: base + Rz(40 deg) (0.2, -0.05).
+  const double c = std::cos(DegToRad(40.0)), n = std::sin(DegToRad(40.0));
+  const RobotPose prior = CameraPrior(s.base, s.mount);
+  EXPECT_NEAR(prior.x, 2.0 + c * 0.2 + n * 0.05, kExact);
+  EXPECT_NEAR(prior.y, 3.0 + n * 0.2 - c * 0.05, kExact);
+}
+
+// TF gives base_from_cam: its mount (pan, tilt, roll, offsets) composes back to it exactly, and a
+// positive roll turns the image's x axis towards the image's y (down).
+TEST(RosGeometry, TheMountOfATransformComposesBackToIt) {
+  const std::array<CameraMount, 4> mounts = {
+      CameraMount{1.3, DegToRad(25.0), DegToRad(10.0), 0.2, -0.05, 0.0},
+      CameraMount{0.4, DegToRad(-170.0), DegToRad(-30.0), -0.1, 0.3, DegToRad(3.0)},
+      CameraMount{2.0, DegToRad(90.0), DegToRad(60.0), 0.0, 0.0, DegToRad(-20.0)},
+      CameraMount{1.0, 0.0, 0.0, 0.0, 0.0, DegToRad(170.0)}};
+  for (const CameraMount& m : mounts) {
+    const Eigen::Isometry3d base_from_cam = BaseFromCamera(m);
+    const CameraMount got = MountOfBaseFromCamera(base_from_cam);
+    EXPECT_NEAR(WrapAngle(got.pan - m.pan), 0.0, kExact);
+    EXPECT_NEAR(got.tilt, m.tilt, kExact);
+    EXPECT_NEAR(WrapAngle(got.roll - m.roll), 0.0, kExact);
+    EXPECT_NEAR(got.x, m.x, kExact);
+    EXPECT_NEAR(got.y, m.y, kExact);
+    EXPECT_NEAR(got.height, m.height, kExact);
+    EXPECT_TRUE(BaseFromCamera(got).isApprox(base_from_cam, kExact));
+    // The image's x axis x = cos(roll) r + sin(roll) d, r level and d = f x r with
+    // d_z = -cos(tilt): its height is -sin(roll) cos(tilt).
+    const Eigen::Vector3d image_x = base_from_cam.linear().col(0);
+    EXPECT_NEAR(image_x.z(), -std::sin(m.roll) * std::cos(m.tilt), kExact);
+  }
 }
 
 TEST(RosGeometry, MapFromOdomComposesBackToTheTrackedBase) {
@@ -87,6 +129,33 @@ TEST(RosGeometry, OdometryIsInterpolatedAtTheImageStamp) {
   EXPECT_TRUE(OdometryAt(readings, 10.25, 0.1).has_value());   // within the gap
   EXPECT_FALSE(OdometryAt(readings, 10.35, 0.1).has_value());  // beyond it
   EXPECT_FALSE(OdometryAt({}, 10.0, 0.1).has_value());
+}
+
+TEST(RosGeometry, HeadAnglesAreInterpolatedAtTheImageStamp) {
+  const std::vector<StampedHeadAngles> readings = {{10.0, 0.1, 0.2}, {10.2, 0.3, 0.1}};
+  const std::optional<StampedHeadAngles> mid = HeadAnglesAt(readings, 10.05, 0.1);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_NEAR(mid->pan, 0.15, kExact);
+  EXPECT_NEAR(mid->tilt, 0.175, kExact);
+  const std::optional<StampedHeadAngles> before = HeadAnglesAt(readings, 9.95, 0.1);
+  ASSERT_TRUE(before.has_value());  // within the gap: the first reading
+  EXPECT_NEAR(before->pan, 0.1, kExact);
+  EXPECT_FALSE(HeadAnglesAt(readings, 10.35, 0.1).has_value());  // beyond it
+  EXPECT_FALSE(HeadAnglesAt({}, 10.0, 0.1).has_value());
+}
+
+// Images arriving faster than they are tracked: the waiting one is replaced by the newer, each
+// replacement reported (and counted by the node), the newest taken next.
+TEST(RosNodeQueue, TheOldestWaitingImageIsDropped) {
+  NewestOnly<int> slot;
+  EXPECT_FALSE(slot.Put(1));
+  EXPECT_TRUE(slot.Put(2));
+  EXPECT_TRUE(slot.Put(3));
+  ASSERT_TRUE(slot.waiting());
+  EXPECT_EQ(slot.Take(), std::optional<int>(3));
+  EXPECT_FALSE(slot.waiting());
+  EXPECT_FALSE(slot.Take().has_value());
+  EXPECT_FALSE(slot.Put(4));  // nothing waiting: nothing dropped
 }
 
 TEST(RosGeometry, RvizInitialPoseGivesThePapersBounds) {

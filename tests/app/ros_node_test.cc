@@ -4,17 +4,23 @@
 // back stamped with the images' stamps, near the truth, with the integrity monitor's covariance:
 // on ~pose only tracking poses, the truth within the 99.9% region of their covariance, the
 // others on ~pose_degraded; map -> odom on /tf; the status must reach "tracking"; global
-// localisation answers with an error.
+// localisation answers with an error; overlays and diagnostics come out. Then the same with the
+// head's angles and offset from TF base -> camera (static and dynamic transforms) instead of
+// --height and --tilt, and with them from joint_states and the camera from camera_info.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/JointState.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include <cstring>
+#include <functional>
 #include <mutex>
 
 #include "app/ros/ros_geometry.h"
@@ -27,6 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kSource = LINETRACK_SOURCE_DIR;
+const std::string kCameraFile = kSource + "/tests/data/camera_wide.xml";
 
 constexpr int kFrames = 24;  // 2.4 s at 10 frames/s
 constexpr double kHeight = test::kSceneHeight;
@@ -44,6 +51,12 @@ constexpr double kRegion999Chi2Dof3 = 16.266;
 // robot's alert limit is set above them, so that most poses are tracking.
 constexpr const char* kAlertLimit = "0.3,2";
 constexpr double kDeadlineS = 60.0;  // any one wait (sanitizer builds are slow)
+// The TF and joint_states tests' head: panning +-15 degrees, 0.2 m ahead of and 0.05 m right of the
+// base's origin.
+constexpr double kTfPanAmplitudeDeg = 15.0;
+constexpr double kTfOffsetXM = 0.2;
+constexpr double kTfOffsetYM = -0.05;
+const std::string kTfBaseFrame = "robot_base";  // ~base_frame
 
 // What the test hears from the node.
 struct Heard {
@@ -79,116 +92,169 @@ void ExpectNearTruth(const geometry_msgs::PoseWithCovarianceStamped& pose, const
   EXPECT_LT(std::abs(RadToDeg(e.z())), kYawTolDeg) << "frame " << frame;
 }
 
-TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
-  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, 0.0);
-  const RosCore core(fs::temp_directory_path() / ("linetrack_ros_" + std::to_string(getpid())));
-  ASSERT_TRUE(core.ready()) << "roscore did not start";
-  ChildProcess node({LINETRACK_EXE, "ros", "--model", kSource + "/models/hall.cao", "--camera",
-                     kSource + "/tests/data/camera_wide.xml", "--height", std::to_string(kHeight),
-                     "--tilt", std::to_string(kTiltDeg), "--alert-limit", kAlertLimit,
-                     "image:=/camera/image_raw", "odom:=/robot/odom"});
-  ASSERT_TRUE(node.started());
-
-  ros::M_string remappings;
-  ros::init(remappings, "linetrack_ros_test", ros::init_options::NoSigintHandler);
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  Heard heard;
-  ros::Subscriber pose_sub = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
-      "/linetrack/pose", 100, [&](const geometry_msgs::PoseWithCovarianceStampedConstPtr& m) {
-        std::lock_guard<std::mutex> lock(heard.mutex);
-        heard.poses.push_back(*m);
-      });
-  ros::Subscriber degraded_sub = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
-      "/linetrack/pose_degraded", 100,
-      [&](const geometry_msgs::PoseWithCovarianceStampedConstPtr& m) {
-        std::lock_guard<std::mutex> lock(heard.mutex);
-        heard.degraded.push_back(*m);
-      });
-  ros::Subscriber tf_sub =
-      nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
-        std::lock_guard<std::mutex> lock(heard.mutex);
-        for (const geometry_msgs::TransformStamped& t : m->transforms) {
-          if (t.header.frame_id == "map" && t.child_frame_id == "odom") {
-            heard.map_to_odom.push_back(t);
-          }
-          EXPECT_FALSE(t.header.frame_id == "map" && t.child_frame_id == "base_link");
-        }
-      });
-  ros::Subscriber status_sub = nh.subscribe<std_msgs::String>(
-      "/linetrack/status", 100, [&](const std_msgs::StringConstPtr& m) {
-        std::lock_guard<std::mutex> lock(heard.mutex);
-        heard.statuses.push_back(m->data);
-      });
-  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/camera/image_raw", 2);
-  ros::Publisher odom_pub = nh.advertise<nav_msgs::Odometry>("/robot/odom", 100);
-  ros::Publisher initial_pub =
-      nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/initialpose", 1, true);
-  ASSERT_TRUE(WaitFor(
-      [&] {
-        return image_pub.getNumSubscribers() > 0 && odom_pub.getNumSubscribers() > 0 &&
-               initial_pub.getNumSubscribers() > 0 && pose_sub.getNumPublishers() > 0 &&
-               degraded_sub.getNumPublishers() > 0 && status_sub.getNumPublishers() > 0 &&
-               tf_sub.getNumPublishers() > 0;
-      },
-      kDeadlineS))
-      << "the node did not connect";
-
-  // The odometry frame is where the robot started; the initial pose is 0.3 m and 8 degrees off.
-  const Eigen::Isometry3d odom_from_map = PlanarIsometry(hall.frames[0].base.Planar()).inverse();
-  geometry_msgs::PoseWithCovarianceStamped initial;
-  initial.header.frame_id = "map";
-  initial.header.stamp = ros::Time(test::kSceneStart);
-  const Pose3Dof start = hall.frames[0].base.Planar();
-  initial.pose.pose =
-      ToPoseMsg(PlanarIsometry({start.x + 0.25, start.y - 0.15, start.heading + DegToRad(8.0)}));
-  initial.pose.covariance[0] = initial.pose.covariance[7] = 0.25;
-  initial.pose.covariance[35] = 0.06853891945200942;
-  initial_pub.publish(initial);
-
-  std::vector<ros::Time> stamps;
-  for (int i = 0; i < kFrames; ++i) {
-    const ros::Time stamp(test::kSceneStart + test::kSceneStep * i);
-    stamps.push_back(stamp);
-    nav_msgs::Odometry odom;
-    odom.header.stamp = stamp;
-    odom.header.frame_id = "odom";
-    odom.child_frame_id = "base_link";
-    odom.pose.pose = ToPoseMsg(odom_from_map * PlanarIsometry(hall.frames[i].base.Planar()));
-    odom_pub.publish(odom);
-    const size_t before = heard.StatusCount();
-    image_pub.publish(test::ImageMsg(hall.images[i], stamp));
-    ASSERT_TRUE(WaitFor([&] { return heard.StatusCount() > before; }, kDeadlineS))
-        << "no status for frame " << i;
+// `linetrack ros` in its own process against a roscore of the test's, the test's node subscribed
+// to what it publishes and publishing what it hears. One per test suite (ros::init once per
+// process; ctest runs each suite in its own).
+class NodeUnderTest {
+ public:
+  explicit NodeUnderTest(const std::vector<std::string>& flags)
+      : core_(fs::temp_directory_path() / ("linetrack_ros_" + std::to_string(getpid()))) {
+    if (!core_.ready()) return;
+    // --model, and the topics the test publishes on; the rest from `flags`.
+    std::vector<std::string> argv = {LINETRACK_EXE,
+                                     "ros",
+                                     "--model",
+                                     kSource + "/models/hall.cao",
+                                     "--alert-limit",
+                                     kAlertLimit,
+                                     "image:=/camera/image_raw",
+                                     "odom:=/robot/odom"};
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    node_ = std::make_unique<ChildProcess>(argv);
+    ros::M_string remappings;
+    ros::init(remappings, "linetrack_ros_test", ros::init_options::NoSigintHandler);
+    nh_ = std::make_unique<ros::NodeHandle>();
+    spinner_ = std::make_unique<ros::AsyncSpinner>(1);
+    spinner_->start();
+    Subscribe();
+    image_pub = nh_->advertise<sensor_msgs::Image>("/camera/image_raw", 2);
+    odom_pub = nh_->advertise<nav_msgs::Odometry>("/robot/odom", 100);
+    initial_pub = nh_->advertise<geometry_msgs::PoseWithCovarianceStamped>("/initialpose", 1, true);
+    tf_pub = nh_->advertise<tf2_msgs::TFMessage>("/tf", 100);
+    tf_static_pub = nh_->advertise<tf2_msgs::TFMessage>("/tf_static", 1, /*latch=*/true);
   }
-  ASSERT_TRUE(WaitFor([&] { return heard.StatusCount() >= kFrames; }, kDeadlineS));
 
-  std_srvs::Empty empty;
-  EXPECT_FALSE(ros::service::call("/linetrack/global_localization", empty))
-      << "global localisation must answer with an error until it exists";
+  bool started() const { return core_.ready() && node_ && node_->started(); }
 
+  // True once the node has subscribed to the images, odometry and initial pose (and /tf_static
+  // with `tf`) and advertised what the test listens to.
+  bool Connected(bool tf) const {
+    return WaitFor(
+        [&] {
+          return image_pub.getNumSubscribers() > 0 && odom_pub.getNumSubscribers() > 0 &&
+                 initial_pub.getNumSubscribers() > 0 && pose_sub_.getNumPublishers() > 0 &&
+                 degraded_sub_.getNumPublishers() > 0 && status_sub_.getNumPublishers() > 0 &&
+                 tf_sub_.getNumPublishers() > 0 && (!tf || tf_static_pub.getNumSubscribers() > 0);
+        },
+        kDeadlineS);
+  }
+
+  // RViz's "2D Pose Estimate" 0.3 m and 8 degrees off `base`, with RViz's covariance.
+  void PublishInitialPose(const Pose3Dof& base) {
+    geometry_msgs::PoseWithCovarianceStamped initial;
+    initial.header.frame_id = "map";
+    initial.header.stamp = ros::Time(test::kSceneStart);
+    initial.pose.pose =
+        ToPoseMsg(PlanarIsometry({base.x + 0.25, base.y - 0.15, base.heading + DegToRad(8.0)}));
+    initial.pose.covariance[0] = initial.pose.covariance[7] = 0.25;
+    initial.pose.covariance[35] = 0.06853891945200942;
+    initial_pub.publish(initial);
+  }
+
+  // Publishes each frame's odometry (the base `map_from_base` seen from `odom_from_map`; none
+  // before frame `first_odometry`), what `before_image` adds, then its image, and waits for its
+  // status. The images' stamps.
+  std::vector<ros::Time> Drive(const test::RenderedDrive& drive,
+                               const std::vector<Eigen::Isometry3d>& map_from_base,
+                               const Eigen::Isometry3d& odom_from_map,
+                               const std::function<void(int, const ros::Time&)>& before_image,
+                               size_t first_odometry = 0) {
+    std::vector<ros::Time> stamps;
+    for (size_t i = 0; i < drive.images.size(); ++i) {
+      const ros::Time stamp(test::kSceneStart + test::kSceneStep * i);
+      stamps.push_back(stamp);
+      nav_msgs::Odometry odom;
+      odom.header.stamp = stamp;
+      odom.header.frame_id = "odom";
+      odom.child_frame_id = "base_link";
+      odom.pose.pose = ToPoseMsg(odom_from_map * map_from_base[i]);
+      if (i >= first_odometry) odom_pub.publish(odom);
+      if (before_image) before_image(static_cast<int>(i), stamp);
+      const size_t before = heard.StatusCount();
+      image_pub.publish(test::ImageMsg(drive.images[i], stamp));
+      EXPECT_TRUE(WaitFor([&] { return heard.StatusCount() > before; }, kDeadlineS))
+          << "no status for frame " << i;
+    }
+    EXPECT_TRUE(WaitFor([&] { return heard.StatusCount() >= stamps.size(); }, kDeadlineS));
+    return stamps;
+  }
+
+  // Stops the test's node, then the node under test: its exit status.
+  int Stop() {
+    spinner_->stop();
+    ros::shutdown();
+    return node_->Stop();
+  }
+
+  Heard heard;
+  ros::Publisher image_pub, odom_pub, initial_pub, tf_pub, tf_static_pub;
+
+ private:
+  void Subscribe() {
+    pose_sub_ = nh_->subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+        "/linetrack/pose", 100, [this](const geometry_msgs::PoseWithCovarianceStampedConstPtr& m) {
+          std::lock_guard<std::mutex> lock(heard.mutex);
+          heard.poses.push_back(*m);
+        });
+    degraded_sub_ = nh_->subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+        "/linetrack/pose_degraded", 100,
+        [this](const geometry_msgs::PoseWithCovarianceStampedConstPtr& m) {
+          std::lock_guard<std::mutex> lock(heard.mutex);
+          heard.degraded.push_back(*m);
+        });
+    tf_sub_ = nh_->subscribe<tf2_msgs::TFMessage>(
+        "/tf", 100, [this](const tf2_msgs::TFMessageConstPtr& m) {
+          std::lock_guard<std::mutex> lock(heard.mutex);
+          for (const geometry_msgs::TransformStamped& t : m->transforms) {
+            if (t.header.frame_id == "map" && t.child_frame_id == "odom") {
+              heard.map_to_odom.push_back(t);
+            }
+            EXPECT_FALSE(t.header.frame_id == "map" && t.child_frame_id == "base_link");
+          }
+        });
+    status_sub_ = nh_->subscribe<std_msgs::String>("/linetrack/status", 100,
+                                                   [this](const std_msgs::StringConstPtr& m) {
+                                                     std::lock_guard<std::mutex> lock(heard.mutex);
+                                                     heard.statuses.push_back(m->data);
+                                                   });
+  }
+
+  RosCore core_;
+  std::unique_ptr<ChildProcess> node_;
+  std::unique_ptr<ros::NodeHandle> nh_;
+  std::unique_ptr<ros::AsyncSpinner> spinner_;
+  ros::Subscriber pose_sub_, degraded_sub_, tf_sub_, status_sub_;
+};
+
+// Every pose heard against the truth of its frame: on ~pose only tracking ones, near the truth and
+// within the 99.9% region of their covariance; on ~pose_degraded the others; map -> odom on /tf
+// near the true odometry frame; the status reached tracking.
+void ExpectPosesOfTheTruth(Heard& heard, const std::vector<ros::Time>& stamps,
+                           const std::vector<Eigen::Isometry3d>& map_from_base,
+                           const Eigen::Isometry3d& odom_from_map) {
+  const int frames = static_cast<int>(stamps.size());
   std::lock_guard<std::mutex> lock(heard.mutex);
-  ASSERT_EQ(static_cast<int>(heard.statuses.size()), kFrames);  // one per image, in order
+  ASSERT_EQ(static_cast<int>(heard.statuses.size()), frames);  // one per image, in order
   EXPECT_GE(static_cast<int>(heard.poses.size() + heard.degraded.size()),
-            kFrames - kMaxFramesWithoutPose);
+            frames - kMaxFramesWithoutPose);
   std::string statuses;
   for (const std::string& status : heard.statuses)
     statuses += status + " ";
-  EXPECT_GE(static_cast<int>(heard.poses.size()), kFrames - kMaxFramesNotTracking) << statuses;
+  EXPECT_GE(static_cast<int>(heard.poses.size()), frames - kMaxFramesNotTracking) << statuses;
   EXPECT_NE(std::find(heard.statuses.begin(), heard.statuses.end(), "tracking"),
             heard.statuses.end());
   for (const auto& pose : heard.poses) {
     const int i = FrameOf(stamps, pose.header.stamp);
     ASSERT_GE(i, 0) << "a pose stamped " << pose.header.stamp << ", not an image's";
     EXPECT_EQ(heard.statuses[i], "tracking") << "frame " << i << " on ~pose";
-    ExpectNearTruth(pose, hall.frames[i].base.Planar(), i);
+    const Pose3Dof truth = PlanarOf(map_from_base[i]);
+    ExpectNearTruth(pose, truth, i);
     // The truth within the 99.9% region of the published x, y, yaw covariance.
     const Matrix6d covariance = ToMatrix6(pose.pose.covariance);
     ASSERT_TRUE(covariance.allFinite());
     const Eigen::Matrix3d planar = test::PlanarBlock(covariance);
     ASSERT_GT(planar.determinant(), 0.0) << "frame " << i;
-    const Eigen::Vector3d e = PlanarError(pose, hall.frames[i].base.Planar());
+    const Eigen::Vector3d e = PlanarError(pose, truth);
     EXPECT_LT(e.dot(planar.ldlt().solve(e)), kRegion999Chi2Dof3) << "frame " << i;
   }
   for (const auto& pose : heard.degraded) {
@@ -199,19 +265,177 @@ TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
     EXPECT_TRUE(ToMatrix6(pose.pose.covariance).allFinite());
   }
   ASSERT_FALSE(heard.map_to_odom.empty()) << "no map -> odom on /tf";
-  const Eigen::Isometry3d map_from_odom = ToIsometry([&] {
-    geometry_msgs::Pose p;
-    const auto& t = heard.map_to_odom.back().transform;
-    p.position.x = t.translation.x;
-    p.position.y = t.translation.y;
-    p.position.z = t.translation.z;
-    p.orientation = t.rotation;
-    return p;
-  }());
+  const Eigen::Isometry3d map_from_odom = ToIsometry(heard.map_to_odom.back().transform);
   EXPECT_LT((map_from_odom.translation() - odom_from_map.inverse().translation()).norm(),
             kOdomTolM);
-  spinner.stop();
-  ros::shutdown();
+}
+
+// The base's planar poses in the map, one per frame of `drive`.
+std::vector<Eigen::Isometry3d> PlanarMapFromBase(const test::RenderedDrive& drive) {
+  std::vector<Eigen::Isometry3d> map_from_base;
+  for (const SequenceFrame& frame : drive.frames)
+    map_from_base.push_back(PlanarIsometry(frame.base.Planar()));
+  return map_from_base;
+}
+
+// The overlays and the diagnostics the node publishes.
+struct HeardExtras {
+  std::mutex mutex;
+  std::vector<sensor_msgs::Image> overlays;  // headers and sizes only
+  long images_received = -1;                 // the last diagnostics' count
+  std::string hardware_id;
+};
+
+TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, 0.0);
+  NodeUnderTest node({"--camera", kCameraFile, "--height", std::to_string(kHeight), "--tilt",
+                      std::to_string(kTiltDeg)});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ros::NodeHandle nh;
+  HeardExtras extras;
+  ros::Subscriber overlay_sub = nh.subscribe<sensor_msgs::Image>(
+      "/linetrack/overlay", 100, [&](const sensor_msgs::ImageConstPtr& m) {
+        std::lock_guard<std::mutex> lock(extras.mutex);
+        extras.overlays.push_back(*m);
+        extras.overlays.back().data.clear();
+      });
+  ros::Subscriber diagnostics_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(extras.mutex);
+        for (const diagnostic_msgs::DiagnosticStatus& status : m->status) {
+          for (const diagnostic_msgs::KeyValue& value : status.values) {
+            if (value.key != "images received") continue;
+            extras.images_received = std::stol(value.value);
+            extras.hardware_id = status.hardware_id;
+          }
+        }
+      });
+  ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
+  ASSERT_TRUE(WaitFor([&] { return overlay_sub.getNumPublishers() > 0; }, kDeadlineS));
+
+  // The odometry frame is where the robot started.
+  const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
+  const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
+  node.PublishInitialPose(hall.frames[0].base.Planar());
+  // The odometry starts one image late (an odometry node slower to start than the camera's): the
+  // initial pose, applied at the first image without a reading, is anchored at the first one.
+  const std::vector<ros::Time> stamps =
+      node.Drive(hall, map_from_base, odom_from_map, nullptr, /*first_odometry=*/1);
+
+  std_srvs::Empty empty;
+  EXPECT_FALSE(ros::service::call("/linetrack/global_localization", empty))
+      << "global localisation must answer with an error until it exists";
+  ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+
+  // Overlays stamped with their images, up to the last, at the camera's size; diagnostics counting
+  // the images.
+  const auto overlays_done = [&] {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    return !extras.overlays.empty() && extras.overlays.back().header.stamp == stamps.back();
+  };
+  EXPECT_TRUE(WaitFor(overlays_done, kDeadlineS));
+  const auto diagnostics_done = [&] {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    return extras.images_received == kFrames;
+  };
+  EXPECT_TRUE(WaitFor(diagnostics_done, kDeadlineS)) << "no diagnostics counting the images";
+  {
+    std::lock_guard<std::mutex> lock(extras.mutex);
+    EXPECT_EQ(extras.hardware_id, "linetrack");
+    for (const sensor_msgs::Image& overlay : extras.overlays) {
+      const int i = FrameOf(stamps, overlay.header.stamp);
+      ASSERT_GE(i, 0) << "an overlay stamped " << overlay.header.stamp << ", not an image's";
+      EXPECT_EQ(overlay.encoding, "bgr8");
+      EXPECT_EQ(overlay.width, hall.images[i].getWidth());
+      EXPECT_EQ(overlay.height, hall.images[i].getHeight());
+    }
+  }
+  EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
+}
+
+// The head's angles from TF instead of joint_states, without --height and --tilt: the camera 0.2 m
+// ahead of and 0.05 m right of the base's origin (static robot_base -> head on /tf_static), panning
+// (head -> camera_optical on /tf at each image's stamp). The base's truth is the rendered camera
+// moved back by that mount, so that a mount taken wrongly (the offset, a stale pan) misses it.
+TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
+  // A generous wait for TF to reach each image's stamp: it comes on another connection. The
+  // base's frame is a private parameter (`_name:=` sets it on the parameter server), and the
+  // command line's --head wins over the parameter server's ~head.
+  NodeUnderTest node({"--camera", kCameraFile, "--odom-wait", "1", "_base_frame:=" + kTfBaseFrame,
+                      "_head:=fixed", "--head", "tf"});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ASSERT_TRUE(node.Connected(/*tf=*/true)) << "the node did not connect";
+
+  geometry_msgs::TransformStamped base_to_head;
+  base_to_head.header.frame_id = kTfBaseFrame;
+  base_to_head.child_frame_id = "head";
+  base_to_head.transform.translation.x = kTfOffsetXM;
+  base_to_head.transform.translation.y = kTfOffsetYM;
+  base_to_head.transform.translation.z = kHeight;
+  base_to_head.transform.rotation.w = 1.0;
+  tf2_msgs::TFMessage static_tf;
+  static_tf.transforms.push_back(base_to_head);
+  node.tf_static_pub.publish(static_tf);
+
+  std::vector<CameraMount> mounts;
+  std::vector<Eigen::Isometry3d> map_from_base;
+  for (const SequenceFrame& frame : hall.frames) {
+    mounts.push_back(
+        {frame.camera.height, frame.pan, frame.camera.tilt, kTfOffsetXM, kTfOffsetYM, 0.0});
+    map_from_base.push_back(frame.cam_from_world.inverse() *
+                            BaseFromCamera(mounts.back()).inverse());
+  }
+  const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
+  node.PublishInitialPose(PlanarOf(map_from_base[0]));
+  const std::vector<ros::Time> stamps =
+      node.Drive(hall, map_from_base, odom_from_map, [&](int i, const ros::Time& stamp) {
+        geometry_msgs::TransformStamped head_to_camera;
+        head_to_camera.header.stamp = stamp;
+        head_to_camera.header.frame_id = "head";
+        head_to_camera.child_frame_id = "camera_optical";  // the images' frame_id
+        Eigen::Isometry3d rotation = BaseFromCamera(mounts[i]);
+        rotation.translation().setZero();
+        head_to_camera.transform = ToTransformMsg(rotation);
+        tf2_msgs::TFMessage tf;
+        tf.transforms.push_back(head_to_camera);
+        node.tf_pub.publish(tf);
+      });
+  ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+  EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
+}
+
+// The head's angles from joint_states (the pan and tilt joints named on the command line), the
+// head panning +-15 degrees: each image takes the angles at its stamp. The camera from
+// camera_info (no --camera).
+TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
+  NodeUnderTest node({"--odom-wait", "1", "--height", std::to_string(kHeight), "--pan-joint",
+                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints",
+                      "camera_info:=/camera/camera_info"});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ros::NodeHandle nh;
+  ros::Publisher joints_pub = nh.advertise<sensor_msgs::JointState>("/robot/joints", 100);
+  ros::Publisher info_pub =
+      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, /*latch=*/true);
+  info_pub.publish(test::CameraInfoOf(ReadCameraXml(kCameraFile)));
+  ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
+  ASSERT_TRUE(WaitFor(
+      [&] { return joints_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0; },
+      kDeadlineS));
+
+  const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
+  const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
+  node.PublishInitialPose(hall.frames[0].base.Planar());
+  const std::vector<ros::Time> stamps =
+      node.Drive(hall, map_from_base, odom_from_map, [&](int i, const ros::Time& stamp) {
+        sensor_msgs::JointState joints;
+        joints.header.stamp = stamp;
+        joints.name = {"head_pan", "head_tilt"};
+        joints.position = {hall.frames[i].pan, hall.frames[i].camera.tilt};
+        joints_pub.publish(joints);
+      });
+  ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
 }
 

@@ -3,6 +3,7 @@
 // degrees down, the head panning by `pan_amplitude`, 5 unmodelled objects.
 #pragma once
 
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
 #include <Eigen/Core>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/render/scene_renderer.h"
 #include "models/render/sequence.h"
@@ -69,6 +71,18 @@ inline sensor_msgs::Image ImageMsg(const vpImage<unsigned char>& image, const ro
   msg.step = msg.width;
   msg.data.assign(image.bitmap, image.bitmap + image.getSize());
   return msg;
+}
+
+// The camera's CameraInfo (plumb_bob with k1 = ViSP's kud).
+inline sensor_msgs::CameraInfo CameraInfoOf(const CameraIntrinsics& camera) {
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = "camera_optical";
+  info.width = camera.width;
+  info.height = camera.height;
+  info.K = {camera.px, 0.0, camera.u0, 0.0, camera.py, camera.v0, 0.0, 0.0, 1.0};
+  info.distortion_model = "plumb_bob";
+  info.D = {camera.has_distortion ? camera.kud : 0.0, 0.0, 0.0, 0.0, 0.0};
+  return info;
 }
 
 }  // namespace linetrack::test

@@ -30,8 +30,10 @@ constexpr double kJacobianTol = 1e-5;   // pixels per unit of delta, central dif
 constexpr double kExactPoseTol = 1e-8;  // metres, radians: exact projections
 constexpr double kExactPx = 1e-9;
 
-// Exact detections of the standing board in every view of `s` (all corners, in id order).
-std::vector<PatternDetection> ExactDetections(const MountScene& s) {
+// Exact detections of the standing board in every view of `s` (all corners, in id order)
+// under the distortion `model`.
+std::vector<PatternDetection> ExactDetections(const MountScene& s,
+                                              DistortionModel model = DistortionModel::kKud) {
   const std::vector<Eigen::Vector3d> board = BoardPoints(s.pattern);
   std::vector<PatternDetection> detections;
   for (const HeadAngles& a : s.angles) {
@@ -39,7 +41,7 @@ std::vector<PatternDetection> ExactDetections(const MountScene& s) {
     d.found = true;
     const Eigen::Isometry3d pose = CamFromBoard(s.tilt_from_camera, s.base_from_board, a);
     for (size_t k = 0; k < board.size(); ++k) {
-      d.image_points.push_back(ProjectBoardPoint(s.camera, pose, board[k]));
+      d.image_points.push_back(ProjectPoint(s.camera, pose * board[k], nullptr, model));
       d.point_ids.push_back(static_cast<int>(k));
     }
     detections.push_back(d);
@@ -72,6 +74,28 @@ TEST(MountMath, ProjectionDerivativeAndViSPsModel) {
     step[k] = h;
     const Eigen::Vector2d numeric =
         (ProjectPoint(s.camera, p + step, nullptr) - ProjectPoint(s.camera, p - step, nullptr)) /
+        (2 * h);
+    EXPECT_LT((numeric - d.col(k)).norm(), kJacobianTol) << "column " << k;
+  }
+}
+
+// The inverse of kdu: its pixel undistorts (CameraIntrinsics::Undistort) to the pinhole pixel,
+// and its derivative matches central differences.
+TEST(MountMath, ProjectionThroughTheInverseOfKdu) {
+  MountScene s = MakeMountScene(1);
+  s.camera.kdu = 0.085;
+  const Eigen::Vector3d p(0.31, -0.22, 1.4);
+  Eigen::Matrix<double, 2, 3> d;
+  const Eigen::Vector2d uv = ProjectPoint(s.camera, p, &d, DistortionModel::kInverseOfKdu);
+  EXPECT_LT((s.camera.Undistort(uv) - s.camera.Project(p)).norm(), kExactPx);
+  EXPECT_GT((uv - s.camera.Project(p)).norm(), 0.5);  // the distortion is not negligible here
+  const double h = 1e-6;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    step[k] = h;
+    const Eigen::Vector2d numeric =
+        (ProjectPoint(s.camera, p + step, nullptr, DistortionModel::kInverseOfKdu) -
+         ProjectPoint(s.camera, p - step, nullptr, DistortionModel::kInverseOfKdu)) /
         (2 * h);
     EXPECT_LT((numeric - d.col(k)).norm(), kJacobianTol) << "column " << k;
   }
@@ -127,6 +151,26 @@ TEST(MountCalibration, RecoversTheMountFromExactProjections) {
   // ViSP's closed form is already exact on exact poses.
   EXPECT_LT(PoseDelta(m.hand_eye_start, s.tilt_from_camera).norm(), 1e-6);
   EXPECT_GT(m.axis_spread, 0.3);
+}
+
+// Images drawn through the inverse of kdu (the scene renderer's model): the refinement in that
+// model recovers the mount exactly; in ViSP's kud model (not kdu's exact inverse) it does not.
+TEST(MountCalibration, RefinesInTheDistortionModelOfTheImages) {
+  MountScene s = MakeMountScene(4);
+  s.camera.kdu = 0.085;
+  const std::vector<PatternDetection> detections =
+      ExactDetections(s, DistortionModel::kInverseOfKdu);
+  MountCalibrationOptions options = Options(s);
+  options.distortion = DistortionModel::kInverseOfKdu;
+  const MountCalibration m =
+      CalibrateMountFromDetections(Names(s.angles.size()), s.angles, detections, s.camera, options);
+  ASSERT_TRUE(m.ok()) << m.message;
+  EXPECT_LT(PoseDelta(m.tilt_from_camera, s.tilt_from_camera).norm(), kExactPoseTol);
+  EXPECT_LT(m.rms_px, 1e-6);
+  const MountCalibration kud = CalibrateMountFromDetections(Names(s.angles.size()), s.angles,
+                                                            detections, s.camera, Options(s));
+  ASSERT_TRUE(kud.ok()) << kud.message;
+  EXPECT_GT(kud.rms_px, 1e-3);
 }
 
 TEST(MountCalibration, NamesAViewTakenAtWrongAnglesAndLeavesItOut) {

@@ -5,13 +5,14 @@
 #include <string>
 
 #include "models/cao_reader.h"
-#include "models/errors.h"
+#include "tests/fuzz/fuzz_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     linetrack::ParseCao(text, "fuzz.cao", nullptr);
-  } catch (const linetrack::InputError&) {
+  } catch (const linetrack::InputError& e) {
+    linetrack::ExpectNamesFile(e, "fuzz.cao");
   }
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <opencv2/calib3d.hpp>
 
 #include "models/errors.h"
@@ -187,6 +188,25 @@ TEST(CameraFile, RefusesWhatItCannotRepresent) {
   EXPECT_NE(
       ErrorOf([&] { ParseRosCameraInfo("camera_matrix: [1, 2", "c.yaml"); }).find("malformed YAML"),
       std::string::npos);
+}
+
+// Sizes are checked before OpenCV allocates them; a binary file is refused before any parser.
+TEST(CameraFile, RefusesMatricesWhoseSizeDoesNotMatchTheirData) {
+  std::string huge = kOpenCvText;
+  huge.replace(huge.find("rows: 3"), 7, "rows: 2000000000");
+  EXPECT_NE(
+      ErrorOf([&] { ParseOpenCvCamera(huge, "c.yml"); }).find("camera_matrix: 2000000000 x 3"),
+      std::string::npos);
+  std::string short_data = kOpenCvText;
+  short_data.replace(short_data.find("rows: 5"), 7, "rows: 6");
+  EXPECT_NE(ErrorOf([&] {
+              ParseOpenCvCamera(short_data, "c.yml");
+            }).find("distortion_coefficients: 6 x 1 does not match its 5 values"),
+            std::string::npos);
+  const std::string path = ::testing::TempDir() + "binary_camera.yml";
+  std::ofstream(path) << std::string("%YAML:1.0\n\0\0", 13);
+  EXPECT_NE(ErrorOf([&] { ReadCameraFile(path); }).find("a NUL byte at offset 10"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -11,9 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/import/import_guards.h"
 #include "models/wireframe.h"
 #include "tests/support/obj_export.h"
 
@@ -330,6 +333,62 @@ TEST(ModelImport, BadFileIsAnInputErrorNamingIt) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
   }
   EXPECT_THROW(ImportModel(TempPath("missing.obj"), ModelImportOptions()), InputError);
+}
+
+// The error of ImportModel on `path`, or "" when it imports.
+std::string ImportError(const std::string& path) {
+  try {
+    ImportModel(path, ModelImportOptions());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Assimp 5.2.5 does not return on the first header; the others claim more than the file holds,
+// break the grammar, or (without the .ply extension) are found by their magic.
+TEST(ModelImport, MalformedPlyHeadersAreRefusedBeforeAssimp) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\n";
+  const std::string body = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string face = "property list uchar int vertex_indices\n";
+  for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
+           {"extra.ply", head + "element face 1 1 2\n" + face + body},
+           {"count.ply", head + "element face 99999999\n" + face + body},
+           {"binary.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty float x\n"
+            "end_header\n0000"},
+           {"type.ply", head + "element face 1\nproperty list uchar quad idx\n" + body},
+           {"orphan.ply", "ply\nformat ascii 1.0\nproperty float x\n" + body},
+           {"noend.ply", head},
+           {"magic.obj", head + "element face 1 1 2\n" + face + body}}) {
+    const std::string path = Write(name, text);
+    const std::string error = ImportError(path);
+    EXPECT_NE(error.find(path), std::string::npos) << name << ": " << error;
+    EXPECT_NE(error.find("PLY header"), std::string::npos) << name << ": " << error;
+  }
+  EXPECT_EQ(ImportError(Write("one.ply", head + "element face 1\n" + face + body)), "");
+}
+
+TEST(CheckPlyText, CountsMustFitTheFile) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property double y\nend_header\n";
+  // Two records of 4 + 8 bytes.
+  EXPECT_NO_THROW(CheckPlyText(header, header.size() + 24, "a.ply"));
+  EXPECT_THROW(CheckPlyText(header, header.size() + 23, "a.ply"), InputError);
+}
+
+TEST(MeshToCao, NonFiniteOrFarPointsAndBadIndicesAreInputErrors) {
+  ImportMesh mesh = Room();
+  mesh.points[0].x() = std::nan("");
+  EXPECT_THROW(MeshToCao(mesh, MeshToCaoOptions(), "nan.obj", nullptr), InputError);
+  mesh.points[0].x() = 1e300;
+  EXPECT_THROW(MeshToCao(mesh, MeshToCaoOptions(), "far.obj", nullptr), InputError);
+  mesh = Room();
+  mesh.triangles[0][1] = static_cast<int>(mesh.points.size());
+  EXPECT_THROW(MeshToCao(mesh, MeshToCaoOptions(), "index.obj", nullptr), InputError);
 }
 
 }  // namespace

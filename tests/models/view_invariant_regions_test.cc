@@ -166,6 +166,28 @@ INSTANTIATE_TEST_SUITE_P(BundledModels, RegionsPartition,
                          ::testing::Combine(::testing::Values("hall.cao", "room.cao"),
                                             ::testing::Values(0.0, 1.0)));
 
+// The lists are computed on several threads: any number gives the same regions, bit for bit.
+TEST(ViewInvariantRegions, ThreadsDoNotChangeTheRegions) {
+  const WireframeModel model = WireframeModel::Load(kModels + "/office.cao");
+  ViewInvariantRegionsOptions one, three;
+  one.threads = 1;
+  three.threads = 3;
+  const Built a = BuildFor(model, one), b = BuildFor(model, three);
+  ASSERT_EQ(a.vir.size(), b.vir.size());
+  ASSERT_GT(a.vir.size(), 3 * 64);  // enough regions for three threads
+  for (int r = 0; r < a.vir.size(); ++r) {
+    const ViewRegion &x = a.vir.regions()[r], &y = b.vir.regions()[r];
+    EXPECT_EQ(x.polygon.vertices, y.polygon.vertices) << r;
+    ASSERT_EQ(x.visible.size(), y.visible.size()) << r;
+    for (size_t k = 0; k < x.visible.size(); ++k) {
+      EXPECT_EQ(x.visible[k].edge_id, y.visible[k].edge_id);
+      EXPECT_EQ(x.visible[k].bearing_min, y.visible[k].bearing_min);
+      EXPECT_EQ(x.visible[k].bearing_max, y.visible[k].bearing_max);
+      EXPECT_EQ(x.visible[k].all_bearings, y.visible[k].all_bearings);
+    }
+  }
+}
+
 TEST(ViewInvariantRegions, HallOccludersAndSolids) {
   const Built b = BuildFor(WireframeModel::Load(kModels + "/hall.cao"));
   EXPECT_EQ(b.vir.occluders().size(), 15u);  // 4 walls, 3 partition faces, 2 x 4 pillar faces

@@ -92,6 +92,28 @@ TEST(IntegrityResidual, JacobiansMatchFiniteDifferences) {
   }
 }
 
+TEST(IntegrityResidual, CasingOffsetsAreTheEndResidualsOfAShiftedEdge) {
+  const CameraIntrinsics camera = TestCamera();
+  const Eigen::Isometry3d pose = TestFreePose();
+  EdgeObservation jamb;  // a jamb on a wall x = 6 seen obliquely, pulled along the wall
+  jamb.a = Eigen::Vector3d(6.0, 1.2, 0.0);
+  jamb.b = Eigen::Vector3d(6.0, 1.2, 2.05);
+  jamb.casing_direction = Eigen::Vector3d(0.0, 1.0, 0.0);
+  const Eigen::Vector2d k = CasingOffsets(jamb, pose, camera);
+  const Eigen::Vector2d pa = camera.Project(pose * jamb.a), pb = camera.Project(pose * jamb.b);
+  constexpr double kShiftM = 1e-5;
+  const Eigen::Vector3d shift = kShiftM * jamb.casing_direction;
+  for (int end = 0; end < 2; ++end) {
+    const Eigen::Vector2d& p = end == 0 ? pa : pb;
+    const double numeric =
+        LinearisePointOnEdge(jamb.a + shift, jamb.b + shift, pose, camera, p).residual / kShiftM;
+    EXPECT_NEAR(k[end], numeric, 1e-4 * std::abs(numeric)) << "end " << end;
+  }
+  // A shift along the edge itself moves nothing.
+  jamb.casing_direction = Eigen::Vector3d(0.0, 0.0, 1.0);
+  EXPECT_NEAR(CasingOffsets(jamb, pose, camera).norm(), 0.0, 1e-9);
+}
+
 // The robot's unknowns and its height and tilt map to world twists as TwistOf... say.
 TEST(IntegrityResidual, RobotParametersMapToWorldTwists) {
   const RobotPose robot = TestRobotPose();

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "models/cao_reader.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 #include "tests/tracking/visp_data.h"
@@ -227,6 +228,31 @@ TEST(RobotReadings, GroundTruthIsTheNearestPoseWithinTolerance) {
   EXPECT_FALSE(GroundTruthAt(poses, 0.5, 0.05));
   EXPECT_NEAR(MedianTimeStep({0.0, 0.1, 0.2, 0.35}), 0.1, kTol);
   EXPECT_EQ(MedianTimeStep({1.0}), 0.0);
+}
+
+TEST(EdgeTracker, FrameLinesOnAWallCanBePulledAcrossThemselves) {
+  // A wall x = 0 (normal +x), a door's jamb and lintel drawn on it as 3D lines, and a free line
+  // in the air.
+  CaoModel cao;
+  cao.points = {{0, 0, 0},    {0, 4, 0},      {0, 4, 2.6}, {0, 0, 2.6}, {0, 1, 0},
+                {0, 1, 2.05}, {0, 1.9, 2.05}, {1, 1, 1},   {1, 2, 1}};
+  cao.faces = {{0, 1, 2, 3}};
+  cao.lines = {{4, 5}, {5, 6}, {7, 8}};
+  cao.face_names = {"wall"};
+  cao.line_names = {"jamb", "lintel", "wire"};
+  const WireframeModel model = WireframeModel::FromCao(cao);
+  const std::vector<Eigen::Vector3d> directions = CasingDirections(model, 0.005);
+  ASSERT_EQ(directions.size(), model.edges().size());
+  for (const ModelEdge& edge : model.edges()) {
+    const Eigen::Vector3d& u = directions[edge.id];
+    if (edge.name == "jamb") {
+      EXPECT_NEAR(std::abs(u.y()), 1.0, 1e-12) << "across a vertical jamb: along the wall";
+    } else if (edge.name == "lintel") {
+      EXPECT_NEAR(std::abs(u.z()), 1.0, 1e-12) << "across a lintel: vertical";
+    } else {
+      EXPECT_TRUE(u.isZero()) << edge.name << ": a face edge or a line on no face";
+    }
+  }
 }
 
 TEST(EdgeTracker, FailuresSpeakOfTheSettingsNotOfViSPsApi) {

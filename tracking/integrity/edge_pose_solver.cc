@@ -77,6 +77,10 @@ bool Linearise(const EdgeObservation& observation, const CameraIntrinsics& camer
     out->basis.row(i) << 1.0 - t, t;
   }
   out->edge_covariance = EdgeLevelCovariance(a.z(), b.z(), 0.5 * (camera.px + camera.py), noise);
+  if (noise.casing_sigma_m > 0.0 && !observation.casing_direction.isZero()) {
+    const Eigen::Vector2d k = CasingOffsets(observation, pose, camera);
+    out->edge_covariance += noise.casing_sigma_m * noise.casing_sigma_m * k * k.transpose();
+  }
   return true;
 }
 
@@ -293,8 +297,10 @@ bool Assemble(const std::vector<EdgeObservation>& observations, const CameraIntr
 
 bool EdgeNoiseOptions::Check(std::string* why) const {
   if (!(min_point_sigma_px > 0.0) || !(huber_sigmas > 0.0) || !(model_sigma_m >= 0.0) ||
-      !(latch_sigma_px >= 0.0) || !(max_edge_scale >= 1.0)) {
-    *why = "edge noise: point sigma and Huber width > 0, model and latch sigmas >= 0, scale >= 1";
+      !(latch_sigma_px >= 0.0) || !(casing_sigma_m >= 0.0) || !(max_edge_scale >= 1.0)) {
+    *why =
+        "edge noise: point sigma and Huber width > 0, model, latch and casing sigmas >= 0, scale "
+        ">= 1";
     return false;
   }
   return true;
@@ -333,6 +339,15 @@ Eigen::Matrix2d EdgeLevelCovariance(double z_a, double z_b, double focal_px,
   Eigen::Matrix2d s;
   s << ka * ka + latch, latch, latch, kb * kb + latch;
   return s;
+}
+
+Eigen::Vector2d CasingOffsets(const EdgeObservation& edge, const Eigen::Isometry3d& cam_from_world,
+                              const CameraIntrinsics& camera) {
+  const EdgeLineProjection line(edge.a, edge.b, cam_from_world, camera);
+  const Eigen::Vector3d dn = -line.NormalOfTwist().leftCols<3>() * edge.casing_direction;
+  const Eigen::Vector2d pa = camera.Project(cam_from_world * edge.a);
+  const Eigen::Vector2d pb = camera.Project(cam_from_world * edge.b);
+  return {line.At(pa).d_normal.dot(dn), line.At(pb).d_normal.dot(dn)};
 }
 
 Eigen::Matrix2d WoodburyKernel(const Eigen::Matrix2d& edge_covariance,

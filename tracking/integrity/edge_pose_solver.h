@@ -31,6 +31,12 @@ struct EdgeNoiseOptions {
   // the median sigma 2.5x the median error (docs/integrity.md, section 4).
   double model_sigma_m = 0.003;
   double latch_sigma_px = 0.2;
+  // A frame line's edge (EdgeObservation::casing_direction) may be pulled onto a casing beside
+  // it: a shift of the whole edge by c ~ N(0, casing_sigma_m^2) metres along that direction, whose
+  // image offsets k c at the two ends (CasingOffsets) add casing_sigma_m^2 k k' to the edge's
+  // covariance. Door casings are 5-10 cm wide (0.05 on drives past casings; off by default: it
+  // widens every frame line's error, cased or not, docs/integrity.md section 1.5).
+  double casing_sigma_m = 0.0;
   // The edge-level covariance is scaled by lambda >= 1, chosen so that the median over edges of
   // the edges' own offsets' chi-square matches chi2(2)'s (robust to a faulty edge); at most this.
   bool estimate_edge_scale = true;
@@ -135,6 +141,13 @@ Eigen::Matrix<double, 6, 6> WorldTwistCovariance(const EdgePoseSolution& solutio
 // (metres) and focal length f (pixels): diag((f s_m / z_a)^2, (f s_m / z_b)^2) + s_l^2 [1 1; 1 1].
 Eigen::Matrix2d EdgeLevelCovariance(double z_a, double z_b, double focal_px,
                                     const EdgeNoiseOptions& noise);
+
+// The change of the residuals (pixels) of points at the image of the edge's ends a and b when
+// the edge moves by one metre along edge.casing_direction (world), seen from cam_from_world:
+// moving the edge by u is moving the camera centre by -u, so the plane normal changes by
+// -R [B - A]x u and each end's residual by dr/dn times that (first order).
+Eigen::Vector2d CasingOffsets(const EdgeObservation& edge, const Eigen::Isometry3d& cam_from_world,
+                              const CameraIntrinsics& camera);
 
 // Whitened information of residuals r = J x + U beta + n, beta ~ N(0, S) and n ~ N(0, D^-1)
 // (D diagonal): the inverse covariance D - D U (I + S U'DU)^-1 S U'D (Woodbury; S may be

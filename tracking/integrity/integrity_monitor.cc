@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "models/geometry.h"
+#include "models/text_format.h"
 #include "tracking/integrity/consistency.h"
 
 namespace linetrack {
@@ -94,12 +95,6 @@ double LogBayesFactor(const Eigen::MatrixXd& c, const Eigen::MatrixXd& b,
   return -0.5 * log_det + 0.5 * (s_w.squaredNorm() - s_w.dot(ldlt.solve(s_w)));
 }
 
-std::string Fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
-
 // Widens the levels and the covariance of `out` to bound the error of `start` rather than of the
 // solution: |e_start| <= |e_solution| + |start - solution| in position and in rotation angle.
 void BoundStartPose(const Eigen::Isometry3d& start, PoseIntegrity* out) {
@@ -111,6 +106,7 @@ void BoundStartPose(const Eigen::Isometry3d& start, PoseIntegrity* out) {
   const double d_rotation =
       Eigen::AngleAxisd(start.linear() * solution.linear().transpose()).angle();
   out->levels.position_m += d_centre.norm();
+  out->levels.start_offset_position_m = d_centre.norm();
   out->levels.rotation_rad += d_rotation;
   out->world_covariance.topLeftCorner<3, 3>() += d_centre * d_centre.transpose();
   out->world_covariance.bottomRightCorner<3, 3>().diagonal().array() += d_rotation * d_rotation;
@@ -128,8 +124,14 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
     return;
   }
   if (!position_ok) {
+    // What sets the level: the fault-free bound or one edge's fault, and the start pose's offset.
+    const std::string limit =
+        pl.limiting_position_edge < 0
+            ? "fault-free"
+            : "an edge fault; fault-free " + Fixed(pl.fault_free_position_m, 3) + " m";
     Append(&out->reason, "position protection " + Fixed(pl.position_m, 3) + " m > " +
-                             Fixed(options.alert_position_m, 3) + " m");
+                             Fixed(options.alert_position_m, 3) + " m (" + limit + ", start +" +
+                             Fixed(pl.start_offset_position_m, 3) + " m)");
   }
   if (!rotation_ok) {
     Append(&out->reason, "rotation protection " + Fixed(RadToDeg(pl.rotation_rad), 2) + " deg > " +

@@ -95,6 +95,8 @@ struct ProtectionLevels {
   double fault_free_position_m = 0.0;
   double fault_free_rotation_rad = 0.0;
   int limiting_position_edge = -1;  // observation whose fault sets the level; -1 fault-free
+  // With bound_start_pose: the start pose's distance from the solution, included in the levels.
+  double start_offset_position_m = 0.0;
   int limiting_rotation_edge = -1;
 };
 ProtectionLevels ComputeProtectionLevels(const EdgePoseSolution& solution,

@@ -5,16 +5,13 @@
 #include <cmath>
 
 #include "models/errors.h"
+#include "models/text_format.h"
 #include "tracking/head/head_pointing.h"
 
 namespace linetrack {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "models/occlusion.h"
@@ -186,6 +187,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
     if (!e.points.empty()) used.push_back(std::move(e));
   }
   out.points = PointCount(used);
+  out.refusal = "too few points";
   if (out.points < options.min_points) return out;
 
   const PoseParameters parameters(start, known);
@@ -193,6 +195,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   IrlsState solve;
   Eigen::VectorXd& r = solve.r;
   r.resize(out.points);
+  out.refusal = "an edge behind the camera";
   if (!Residuals(used, camera, start, &r)) return out;
   out.rms_before_px = Rms(r);
 
@@ -201,9 +204,11 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   std::vector<ViewedEdge> set_aside;
   for (int rejections = 0;; ++rejections) {
     const int n = PointCount(used);
+    out.refusal = "too few points after setting edges aside";
     if (n < options.min_points) return out;
     solve.p = Eigen::VectorXd::Zero(dof);
     r.resize(n);
+    out.refusal = "the solve failed";
     if (!SolveIrls(used, camera, parameters, options, &solve)) return out;
     if (rejections == options.max_edge_rejections) break;
     const std::vector<double> means = EdgeMeanResiduals(used, r);
@@ -227,6 +232,7 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
   Eigen::VectorXd r_start(r.size());
   const Eigen::Isometry3d reference = known ? parameters.Pose(Eigen::VectorXd::Zero(dof)) : start;
   if (!Residuals(used, camera, reference, &r_start)) return out;
+  out.refusal = "no better fit than the start";
   if (!(WeightedCost(r, options.huber_px) <= WeightedCost(r_start, options.huber_px))) return out;
   // Refuse large corrections: they mean the edge points were not where they were looked for.
   double motion = 0.0;
@@ -234,8 +240,12 @@ EdgeRefinement SolveOnEdgePoints(std::vector<ViewedEdge> viewed, const CameraInt
     motion += (camera.Project(pose * e.a) - camera.Project(start * e.a)).norm() +
               (camera.Project(pose * e.b) - camera.Project(start * e.b)).norm();
   }
+  char text[64];
+  std::snprintf(text, sizeof(text), "correction %.1f px", motion / (2.0 * used.size()));
+  out.refusal = text;
   if (!(motion / (2.0 * used.size()) <= options.max_correction_px)) return out;
   out.applied = true;
+  out.refusal.clear();
   out.cam_from_world = pose;
   out.points = PointCount(used);
   out.observations = std::move(used);

@@ -57,11 +57,16 @@ struct EdgeObservation {
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector2d> points;  // undistorted pixels
   int model_edge = -1;                  // index of the edge in the refinement's input
+  // Unit direction (world), on the face the edge is drawn on and across the edge, in which an
+  // unmodelled parallel line may lie beside it (the casing of a door or window frame line) and
+  // pull its points; zero when none is expected (tracking/integrity/ widens the edge's error).
+  Eigen::Vector3d casing_direction = Eigen::Vector3d::Zero();
 };
 
 // The outcome of RefineOnEdges.
 struct EdgeRefinement {
   bool applied = false;  // false: too few edge points, no improvement, or a refused correction
+  std::string refusal;   // why not applied ("too few points", "no better fit", "correction N px")
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // refined (or the start)
   int points = 0;                                                    // edge points used
   double rms_before_px = 0.0;  // point-to-line distances at the start pose

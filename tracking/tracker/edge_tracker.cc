@@ -1,4 +1,5 @@
 #include "tracking/tracker/edge_tracker.h"
+
 #include "models/silence_stdout.h"
 
 #include <visp3/core/vpEigenConversion.h>
@@ -21,6 +22,7 @@
 #include "models/cao_writer.h"
 #include "models/errors.h"
 #include "models/geometry.h"
+#include "models/text_format.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -30,12 +32,10 @@ namespace {
 // ViSP's vpMeSite::NO_SUPPRESSION: a moving edge found and kept.
 constexpr double kGoodSiteState = 0.0;
 constexpr double kNearClip = 0.05;  // metres, for the image motion of the model
+// A frame line lies on its face within this (metres).
+constexpr double kCasingPlaneToleranceM = 0.005;
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -152,6 +152,32 @@ void ConfigureVispTracker(const TrackerSettings& settings, const CameraIntrinsic
   tracker->setGoodMovingEdgesRatioThreshold(settings.good_edge_ratio);
 }
 
+std::vector<Eigen::Vector3d> CasingDirections(const WireframeModel& model, double tolerance_m) {
+  std::vector<Eigen::Vector3d> out(model.edges().size(), Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < model.edges().size(); ++i) {
+    const ModelEdge& edge = model.edges()[i];
+    if (!edge.from_line || edge.face >= 0) continue;
+    const Eigen::Vector3d a = edge.segment.a, b = edge.segment.b;
+    for (const ModelFace& face : model.faces()) {
+      if (face.Degenerate() || face.corners.empty()) continue;
+      if (std::abs(face.normal.dot(a) - face.offset) > tolerance_m ||
+          std::abs(face.normal.dot(b) - face.offset) > tolerance_m) {
+        continue;
+      }
+      Eigen::AlignedBox3d extent;
+      for (const Eigen::Vector3d& c : face.corners)
+        extent.extend(c);
+      extent.min().array() -= tolerance_m;
+      extent.max().array() += tolerance_m;
+      if (!extent.contains(a) || !extent.contains(b)) continue;
+      const Eigen::Vector3d across = face.normal.cross(b - a);
+      if (across.norm() > 0.0) out[i] = across.normalized();
+      break;
+    }
+  }
+  return out;
+}
+
 EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& camera,
                          const TrackerSettings& settings)
     : tracker_(std::make_unique<vpMbGenericTracker>(1, vpMbGenericTracker::EDGE_TRACKER)),
@@ -166,6 +192,7 @@ EdgeTracker::EdgeTracker(const std::string& model_path, const CameraIntrinsics& 
   occlusion_ = std::make_unique<OcclusionTester>(*model_);
   for (const ModelEdge& edge : model_->edges())
     edges_.push_back(edge.segment);
+  casing_directions_ = CasingDirections(*model_, kCasingPlaneToleranceM);
   try {
     ConfigureVispTracker(settings_, camera_, tracker_.get());
   } catch (const vpException& e) {
@@ -259,6 +286,7 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
                                            {result.cam_from_world, known}, settings_.refinement);
     health.refined = refined.applied;
     health.refined_points = refined.points;
+    health.refinement_refusal = refined.refusal;
     if (refined.applied) {
       result.cam_from_world = refined.cam_from_world;
       health.refined_rms_before_px = refined.rms_before_px;
@@ -267,6 +295,10 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
       health.refined_position_sigma_m = refined.position_sigma_m;
       health.refined_heading_sigma_deg = RadToDeg(refined.heading_sigma_rad);
       result.observations = std::move(refined.observations);
+      for (EdgeObservation& o : result.observations) {
+        if (o.model_edge >= 0 && o.model_edge < static_cast<int>(casing_directions_.size()))
+          o.casing_direction = casing_directions_[o.model_edge];
+      }
       result.set_aside = std::move(refined.set_aside);
     }
   }

@@ -95,10 +95,17 @@ class EdgeTracker {
   std::unique_ptr<WireframeModel> model_;  // linetrack's reading of the model
   std::unique_ptr<OcclusionTester> occlusion_;
   std::vector<Segment3> edges_;  // the model's edges (world), for the sub-pixel refinement
+  std::vector<Eigen::Vector3d> casing_directions_;  // per edge (CasingDirections)
   CameraIntrinsics camera_;
   TrackerSettings settings_;
   bool started_ = false;
 };
+
+// Per model edge (ids of model.edges()): for a free 3D line drawn on a face (a door or window
+// frame line), the unit direction on that face across the line, n_face x (B - A) normalised, in
+// which a casing may lie beside it; zero for face edges and lines on no face (within
+// `tolerance_m` of the plane and of the face's extent).
+std::vector<Eigen::Vector3d> CasingDirections(const WireframeModel& model, double tolerance_m);
 
 // Moving edges after a ViSP track() call (its display features: {0, i, j, state} per site):
 // how many there are, and the image positions (u, v) of the good ones (vpMeSite::NO_SUPPRESSION).

@@ -4,15 +4,11 @@
 #include <cmath>
 
 #include "models/errors.h"
+#include "models/text_format.h"
 
 namespace linetrack {
 
 namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 bool ValidBounds(const SearchBounds& b) {
   return b.delta_t >= 0.0 && std::isfinite(b.delta_t) && b.delta_phi > 0.0 && b.delta_phi <= kPi;

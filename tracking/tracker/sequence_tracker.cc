@@ -7,16 +7,13 @@
 
 #include "models/errors.h"
 #include "models/statistics.h"
+#include "models/text_format.h"
 
 namespace linetrack {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::optional<KnownHeightTilt> Known(const std::optional<RobotReading>& robot) {
   if (!robot) return std::nullopt;
@@ -42,12 +39,6 @@ Pose3Dof Carry(const Pose3Dof& pose, const RobotReading& then, const RobotReadin
 Eigen::Vector2d PlanarDifference(const Pose3Dof& a, const Pose3Dof& b) {
   return {std::hypot(a.x - b.x, a.y - b.y),
           std::abs(std::remainder(a.heading - b.heading, 2.0 * kPi))};
-}
-
-std::string Fixed(double value, int digits) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.*f", digits, value);
-  return text;
 }
 
 }  // namespace
@@ -128,7 +119,8 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
   if (problem.empty() && robot && options_.robot_requires_refinement &&
       tracker_->settings().refine_subpixel && !result.health.refined) {
     problem = "the image edges do not confirm the pose (sub-pixel refinement: " +
-              std::to_string(result.health.refined_points) + " points)";
+              std::to_string(result.health.refined_points) + " points, " +
+              result.health.refinement_refusal + ")";
   }
   if (problem.empty() && robot) {
     RobotConstraint constraint = options_.robot_tolerances;

@@ -26,6 +26,7 @@ struct TrackHealth {
   // to the model edges before and after (pixels).
   bool refined = false;
   int refined_points = 0;
+  std::string refinement_refusal;  // why the refinement was not applied (EdgeRefinement)
   double refined_rms_before_px = 0.0;
   double refined_rms_after_px = 0.0;
   int refined_rejected_edges = 0;  // edges set aside as lying on unmodelled parallel lines
