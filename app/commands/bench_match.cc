@@ -24,6 +24,7 @@
 #include "models/errors.h"
 #include "models/statistics.h"
 #include "models/synth/synthetic_scenes.h"
+#include "models/text_format.h"
 
 namespace linetrack::app {
 namespace {
@@ -278,25 +279,72 @@ std::string Row(const std::string& matcher, const Tally& t) {
   return row.str();
 }
 
+// One scene of the global series for --diagnose: the truth verified in a search centred on its
+// own heading (its evidence, as the matcher would score it) against every search's finalists,
+// and how far the truth's heading is from the nearest search's.
+nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const Localizer& tree,
+                                           const SyntheticScene& scene, const GlobalResult& r,
+                                           Outcome outcome) {
+  HeadingSearch at_truth;
+  at_truth.heading = scene.truth.heading;
+  at_truth.heading_bound = DegToRad(GlobalOptions().min_heading_bound_deg);
+  const TruthDiagnosis d =
+      DiagnoseTruth(tree, global.SearchProblem({scene.lines, scene.height, scene.tilt}, at_truth),
+                    scene.truth.Planar(), scene.matches);
+  double nearest_deg = 180.0;
+  nlohmann::ordered_json searches = nlohmann::ordered_json::array();
+  for (const HeadingSearch& s : r.searches) {
+    nearest_deg =
+        std::min(nearest_deg, std::abs(RadToDeg(WrapAngle(s.heading - scene.truth.heading))));
+    nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
+    for (const Finalist& f : s.result.finalists) {
+      finalists.push_back({f.pose.x, f.pose.y, RadToDeg(WrapAngle(f.pose.heading)),
+                           f.evidence.Score(), f.matched_edges});
+    }
+    searches.push_back({{"heading_deg", RadToDeg(WrapAngle(s.heading))},
+                        {"bound_deg", RadToDeg(s.heading_bound)},
+                        {"found", s.result.found},
+                        {"reason", s.result.reason},
+                        {"budget_exhausted", s.result.budget_exhausted},
+                        {"finalists", finalists}});
+  }
+  return {{"scene", scene.index},
+          {"outcome", MatchOutcomeName(outcome)},
+          {"ambiguous", r.ambiguous},
+          {"reason", r.reason},
+          {"truth_pose", {scene.truth.x, scene.truth.y, RadToDeg(WrapAngle(scene.truth.heading))}},
+          {"truth_heading_off_deg", nearest_deg},
+          {"truth_plausible", d.plausible},
+          {"truth_implausible_because", d.implausible_because},
+          {"truth_matched_edges", d.matched_edges},
+          {"truth_evidence", d.evidence_score},
+          {"searches", searches}};
+}
+
 // The global mode on a series' scenes, their priors ignored (scenes not in `only`, when given,
-// skipped): the tally and, in *ambiguous, the unanswered scenes answered "ambiguous".
+// skipped): the tally and, in *ambiguous, the unanswered scenes answered "ambiguous"; each
+// scene's diagnosis appended to `diagnosis` when given.
 Tally RunGlobalSeries(const Localizer& tree, const ModelDirections& directions,
                       const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
-                      int* ambiguous) {
+                      int* ambiguous, std::ostringstream* diagnosis) {
   const GlobalLocalizer global(tree, directions, GlobalOptionsFor(tree.options()));
   Tally tally;
   for (const SyntheticScene& scene : scenes) {
     if (!only.empty() && std::find(only.begin(), only.end(), scene.index) == only.end()) continue;
     const auto start = std::chrono::steady_clock::now();
     const GlobalResult r = global.Localize({scene.lines, scene.height, scene.tilt});
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double ms = MillisecondsSince(start);
     LocalizationResult shown = r.found ? r.best : LocalizationResult();
     shown.hypotheses = 0;
     for (const HeadingSearch& h : r.searches)
       shown.hypotheses += h.result.hypotheses;
-    Score(scene, shown, ms, &tally);
+    const Outcome outcome = Score(scene, shown, ms, &tally);
     *ambiguous += r.ambiguous ? 1 : 0;
+    if (diagnosis != nullptr) {
+      nlohmann::ordered_json j = GlobalDiagnosisJson(global, tree, scene, r, outcome);
+      j["ms"] = ms;
+      *diagnosis << j.dump() << "\n";
+    }
   }
   return tally;
 }
@@ -305,9 +353,10 @@ Tally RunGlobalSeries(const Localizer& tree, const ModelDirections& directions,
 // ambiguous answers) appended to *notes.
 std::string GlobalRow(const Localizer& tree, const ModelDirections& directions,
                       const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
-                      const std::string& name, std::ostringstream* notes) {
+                      const std::string& name, std::ostringstream* notes,
+                      std::ostringstream* diagnosis) {
   int ambiguous = 0;
-  const Tally t = RunGlobalSeries(tree, directions, scenes, only, &ambiguous);
+  const Tally t = RunGlobalSeries(tree, directions, scenes, only, &ambiguous, diagnosis);
   *notes << (notes->tellp() > 0 ? "; " : "") << name << ": " << t.correct_beyond_tolerance
          << " (no answer: " << ambiguous << " ambiguous)";
   return "| " + name + " " + Row("heading + tree", t) + "\n";
@@ -370,7 +419,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     baseline_options.sampler = BaselineSampler(baseline_sampling);
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
     if (s.global) {
-      table << GlobalRow(tree, directions, scenes, opt.only, s.name, &beyond);
+      table << GlobalRow(tree, directions, scenes, opt.only, s.name, &beyond, diagnosis.get());
       continue;
     }
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);

@@ -297,7 +297,8 @@ int RunBenchViews(const BenchViewsOptions& opt) {
   if (!s.grid.Check(&why)) throw InputError("--grid/--height/--tilt: " + why);
   const auto start = std::chrono::steady_clock::now();
   const ViewDatabase db = BuildDatabase(s, opt);
-  spdlog::info("{} key views built in {:.1f} s", db.views.size(), MillisecondsSince(start) / 1000.0);
+  spdlog::info("{} key views built in {:.1f} s", db.views.size(),
+               MillisecondsSince(start) / 1000.0);
   std::ostringstream t;
   t << db.views.size() << " key views of " << opt.model_path << " ("
     << (opt.render_db ? "rendered, detected lines" : "projected edges") << ", grid " << opt.grid

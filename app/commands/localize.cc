@@ -132,7 +132,8 @@ int RunBatch(const LocalizeOptions& opt) {
         const auto start = std::chrono::steady_clock::now();
         const GlobalResult result = global.Localize({c.problem.lines, z, c.problem.tilt});
         found += result.found ? 1 : 0;
-        std::cout << GlobalResultToJson(id, result, MillisecondsSince(start), &model).dump() << "\n";
+        std::cout << GlobalResultToJson(id, result, MillisecondsSince(start), &model).dump()
+                  << "\n";
         continue;
       }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);

@@ -140,18 +140,24 @@ GlobalLocalizer::GlobalLocalizer(const Localizer& localizer, const ModelDirectio
   }
 }
 
-GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
+LocalizationProblem GlobalLocalizer::SearchProblem(const GlobalProblem& problem,
+                                                   const HeadingSearch& search) const {
   LocalizationProblem local;
   local.lines = problem.lines;
   local.height = problem.height;
   local.tilt = problem.tilt;
   // The whole navigable area: the disk around its bounding box.
   const Eigen::Vector2d lo = localizer_.area()->BoundsMin(), hi = localizer_.area()->BoundsMax();
-  local.prior.x = 0.5 * (lo.x() + hi.x());
-  local.prior.y = 0.5 * (lo.y() + hi.y());
+  local.prior = {0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), search.heading};
   local.delta_t = 0.5 * (hi - lo).norm();
-  local.delta_phi = DegToRad(options_.min_heading_bound_deg);
-  CheckProblem(local);
+  local.delta_phi = search.heading_bound;
+  return local;
+}
+
+GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
+  HeadingSearch probe;
+  probe.heading_bound = DegToRad(options_.min_heading_bound_deg);
+  CheckProblem(SearchProblem(problem, probe));
 
   GlobalResult out;
   out.headings = EstimateHeading(problem.lines, localizer_.camera(), problem.tilt, directions_,
@@ -161,11 +167,8 @@ GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
     return out;
   }
   out.searches = PlanHeadingSearches(out.headings, options_);
-  for (HeadingSearch& s : out.searches) {
-    local.prior.heading = s.heading;
-    local.delta_phi = s.heading_bound;
-    s.result = localizer_.Localize(local);
-  }
+  for (HeadingSearch& s : out.searches)
+    s.result = localizer_.Localize(SearchProblem(problem, s));
   Decide(localizer_.options().verification, &out);
   return out;
 }

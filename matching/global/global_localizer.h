@@ -73,6 +73,11 @@ class GlobalLocalizer {
   // Throws InputError when the problem is malformed (NaN, empty or zero-length lines).
   GlobalResult Localize(const GlobalProblem& problem) const;
 
+  // The local problem of one search: the disk around the navigable area's bounding box, the
+  // search's heading and bound.
+  LocalizationProblem SearchProblem(const GlobalProblem& problem,
+                                    const HeadingSearch& search) const;
+
  private:
   const Localizer& localizer_;
   const ModelDirections& directions_;
