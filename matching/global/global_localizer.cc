@@ -26,6 +26,10 @@ bool GlobalOptions::Check(std::string* why) const {
         "max_heading_bound_deg < 180";
     return false;
   }
+  if (!(min_support >= 0.0 && min_support <= 1.0)) {
+    *why = "min_support must be in [0, 1]";
+    return false;
+  }
   return true;
 }
 
@@ -93,10 +97,10 @@ std::vector<Explanation> Explanations(const std::vector<HeadingSearch>& searches
   return distinct;
 }
 
-// The answer from the searches: the best explanation when a search accepted it and no distinct
-// pose comes within the ambiguity margin; "ambiguous" with the rivals when one does; else the
-// reason of the search with the best explanation.
-void Decide(const VerificationOptions& vo, GlobalResult* out) {
+// The answer from the searches: the best explanation when a search accepted it, no distinct
+// pose comes within the ambiguity margin and it observes min_support of its predicted outline;
+// "ambiguous" with the rivals when a distinct pose comes within the margin; else the reason.
+void Decide(const VerificationOptions& vo, double min_support, GlobalResult* out) {
   const std::vector<Explanation> explanations = Explanations(out->searches, vo);
   if (explanations.empty()) {
     out->reason = "no heading candidate's search found a plausible pose";
@@ -107,6 +111,13 @@ void Decide(const VerificationOptions& vo, GlobalResult* out) {
   std::vector<Pose3Dof> rivals;
   for (const Explanation& e : explanations) {
     if (e.score > best.score - vo.ambiguity_nats) rivals.push_back(e.pose);
+  }
+  const double support =
+      best_search.finalists.empty() ? 0.0 : best_search.finalists.front().evidence.Support();
+  if (rivals.size() == 1 && best.accepted && support < min_support) {
+    out->reason = "the best pose observes " + std::to_string(static_cast<int>(100.0 * support)) +
+                  " % of its predicted outline (a partial explanation)";
+    return;
   }
   if (rivals.size() == 1 && best.accepted) {
     out->found = true;
@@ -169,7 +180,7 @@ GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
   out.searches = PlanHeadingSearches(out.headings, options_);
   for (HeadingSearch& s : out.searches)
     s.result = localizer_.Localize(SearchProblem(problem, s));
-  Decide(localizer_.options().verification, &out);
+  Decide(localizer_.options().verification, options_.min_support, &out);
   return out;
 }
 

@@ -24,6 +24,10 @@ struct GlobalOptions {
   double heading_sigmas = 3.0;
   double min_heading_bound_deg = 2.0;
   double max_heading_bound_deg = 6.0;
+  // An answer must observe at least this share of its predicted visible outline
+  // (PoseEvidence::Support): over the whole hall, a pose that explains part of the image by a
+  // partial repetition of the building predicts edges the image does not have (docs/global.md).
+  double min_support = 0.6;
 
   bool Check(std::string* why) const;
 };
