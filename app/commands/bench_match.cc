@@ -298,14 +298,20 @@ nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const 
         std::min(nearest_deg, std::abs(RadToDeg(WrapAngle(s.heading - scene.truth.heading))));
     nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
     for (const Finalist& f : s.result.finalists) {
+      std::set<int> lines;
+      for (const auto& m : f.matches)
+        lines.insert(m.second);
       finalists.push_back({f.pose.x, f.pose.y, RadToDeg(WrapAngle(f.pose.heading)),
-                           f.evidence.Score(), f.matched_edges});
+                           f.evidence.Score(), f.matched_edges, f.evidence.Support(), lines.size(),
+                           f.evidence.lines_nats, f.evidence.edges_nats});
     }
     searches.push_back({{"heading_deg", RadToDeg(WrapAngle(s.heading))},
                         {"bound_deg", RadToDeg(s.heading_bound)},
                         {"found", s.result.found},
                         {"reason", s.result.reason},
                         {"budget_exhausted", s.result.budget_exhausted},
+                        {"completed_bound", s.result.tree_completed_bound},
+                        {"unexplained_bound", s.result.unexplained_completed_bound},
                         {"finalists", finalists}});
   }
   return {{"scene", scene.index},
@@ -318,6 +324,7 @@ nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const 
           {"truth_implausible_because", d.implausible_because},
           {"truth_matched_edges", d.matched_edges},
           {"truth_evidence", d.evidence_score},
+          {"lines", scene.lines.size()},
           {"searches", searches}};
 }
 
