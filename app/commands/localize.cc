@@ -73,6 +73,7 @@ void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
                     nlohmann::ordered_json* json) {
   (*json)["found"] = false;
   (*json)["answer"] = result.finalists.size() > 1 ? "ambiguous" : "none";
+  if (json->contains("ambiguous")) (*json)["ambiguous"] = result.finalists.size() > 1;  // global
   (*json)["reason"] = "the answer is not within the alert limit: " + u.reason;
   (*json)["candidate"] = (*json)["pose"];
   (*json)["pose"] = nullptr;
