@@ -89,6 +89,25 @@ void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
   (*json)["rivals"] = rivals;
 }
 
+// Why a global answer from line segments alone is no answer: the global mode's verification can
+// accept a wrong pose where the building repeats itself (docs/global.md), and only the image's
+// integrity check (--image) can tell.
+constexpr const char* kUnverifiedGlobal =
+    "a global answer from line segments alone is not verified: give the image (--image) so "
+    "that its integrity is checked";
+
+// A found global answer without an image becomes a candidate: "found" false, "answer"
+// "unverified", the pose moved to "candidate".
+void MarkUnverified(nlohmann::ordered_json* json) {
+  if (!(*json)["found"].get<bool>()) return;
+  (*json)["found"] = false;
+  (*json)["answer"] = "unverified";
+  (*json)["reason"] = kUnverifiedGlobal;
+  (*json)["candidate"] = (*json)["pose"];
+  (*json)["pose"] = nullptr;
+  (*json)["cMo"] = nullptr;
+}
+
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
   LocalizerOptions options;
   if (!opt.image_path.empty()) options.noise = DetectedLineNoise();
@@ -132,9 +151,10 @@ int RunBatch(const LocalizeOptions& opt) {
         const double z = CameraZ(model, c.problem.height, c.storey, c.floor_z);
         const auto start = std::chrono::steady_clock::now();
         const GlobalResult result = global.Localize({c.problem.lines, z, c.problem.tilt});
-        found += result.found ? 1 : 0;
-        std::cout << GlobalResultToJson(id, result, MillisecondsSince(start), &model).dump()
-                  << "\n";
+        nlohmann::ordered_json json =
+            GlobalResultToJson(id, result, MillisecondsSince(start), &model);
+        MarkUnverified(&json);
+        std::cout << json.dump() << "\n";
         continue;
       }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
@@ -253,8 +273,8 @@ int RunSingle(const LocalizeOptions& opt) {
   if (image && result.found) {
     integrity = CheckAnswer(opt, *image, problem, result, integrity_options);
   }
-  const bool answered =
-      result.found && (!integrity || integrity->status == IntegrityStatus::kTracking);
+  const bool answered = result.found && (integrity ? integrity->status == IntegrityStatus::kTracking
+                                                   : !global_result);
   if (image && !opt.overlay_path.empty()) {
     WriteFileAtomically(
         opt.overlay_path,
@@ -277,8 +297,15 @@ int RunSingle(const LocalizeOptions& opt) {
     if (integrity) {
       json["integrity"] = UncertaintyJson(*integrity);
       if (!answered) WithholdAnswer(result, *integrity, &json);
+    } else if (global_result) {
+      MarkUnverified(&json);
     }
     std::cout << json.dump(2) << std::endl;
+  } else if (result.found && !integrity && global_result) {
+    std::cout << "no answer: the candidate (x " << std::fixed << std::setprecision(3)
+              << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading)) << " deg) is " << kUnverifiedGlobal
+              << "\n";
   } else if (result.found && !answered) {
     std::cout << "no answer: the pose found (x " << std::fixed << std::setprecision(3)
               << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
