@@ -64,15 +64,6 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
     }
     c.problem.lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
   }
-  if (!json.contains("prior") || !json["prior"].is_array() || json["prior"].size() != 3 ||
-      !json["prior"][0].is_number() || !json["prior"][1].is_number() ||
-      !json["prior"][2].is_number()) {
-    throw InputError("key \"prior\" must be [x, y, heading_deg]");
-  }
-  c.problem.prior = {json["prior"][0].get<double>(), json["prior"][1].get<double>(),
-                     DegToRad(json["prior"][2].get<double>())};
-  c.problem.delta_t = FiniteNumber(json, "delta_t");
-  c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
   c.problem.height = FiniteNumber(json, "height");
   if (c.problem.height <= 0.0) {
     throw InputError("key \"height\" is not a camera height (metres above the floor, > 0)");
@@ -85,6 +76,18 @@ BatchCase ParseBatchCase(const nlohmann::json& json, const std::string& base_dir
   }
   if (json.contains("floor_z")) c.floor_z = FiniteNumber(json, "floor_z");
   c.problem.tilt = DegToRad(FiniteNumber(json, "tilt"));
+  if (!json.contains("prior") || json["prior"].is_null()) {
+    c.global = true;  // checked by the global localizer
+    return c;
+  }
+  if (!json["prior"].is_array() || json["prior"].size() != 3 || !json["prior"][0].is_number() ||
+      !json["prior"][1].is_number() || !json["prior"][2].is_number()) {
+    throw InputError("key \"prior\" must be [x, y, heading_deg]");
+  }
+  c.problem.prior = {json["prior"][0].get<double>(), json["prior"][1].get<double>(),
+                     DegToRad(json["prior"][2].get<double>())};
+  c.problem.delta_t = FiniteNumber(json, "delta_t");
+  c.problem.delta_phi = DegToRad(FiniteNumber(json, "delta_phi"));
   CheckProblem(c.problem);
   return c;
 }

@@ -30,5 +30,9 @@ void AddMakeBuilding(CLI::App& cli, CommandAction* action);
 void AddModelImport(CLI::App& cli, CommandAction* action);
 void AddBenchBuilding(CLI::App& cli, CommandAction* action);
 void AddBenchMount(CLI::App& cli, CommandAction* action);
+void AddHeading(CLI::App& cli, CommandAction* action);
+void AddBenchHeading(CLI::App& cli, CommandAction* action);
+void AddViews(CLI::App& cli, CommandAction* action);
+void AddBenchViews(CLI::App& cli, CommandAction* action);
 
 }  // namespace linetrack::app

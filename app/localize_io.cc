@@ -106,11 +106,38 @@ nlohmann::ordered_json ResultToJson(const nlohmann::json& id, const Localization
   return out;
 }
 
+nlohmann::ordered_json GlobalResultToJson(const nlohmann::json& id, const GlobalResult& result,
+                                          double time_ms, const WireframeModel* model) {
+  LocalizationResult shown = result.best;
+  if (!result.found) {
+    shown = LocalizationResult();
+    shown.reason = result.reason;
+    for (const HeadingSearch& s : result.searches)
+      shown.hypotheses += s.result.hypotheses;
+  }
+  nlohmann::ordered_json out = ResultToJson(id, shown, time_ms, model);
+  out["global"] = true;
+  out["ambiguous"] = result.ambiguous;
+  if (!result.found) out["answer"] = result.ambiguous ? "ambiguous" : "none";
+  nlohmann::ordered_json rivals = nlohmann::ordered_json::array();
+  for (const Pose3Dof& p : result.rivals) {
+    rivals.push_back({{"x", p.x}, {"y", p.y}, {"heading_deg", RadToDeg(WrapAngle(p.heading))}});
+  }
+  out["rivals"] = rivals;
+  nlohmann::ordered_json headings = nlohmann::ordered_json::array();
+  for (const HeadingSearch& s : result.searches)
+    headings.push_back(RadToDeg(WrapAngle(s.heading)));
+  out["headings_deg"] = headings;
+  out["searches"] = result.searches.size();
+  return out;
+}
+
 const LoadedModel& LocalizerCache::Model(const std::string& model_path) {
   auto it = models_.find(model_path);
   if (it != models_.end()) return it->second;
   LoadedModel loaded;
   loaded.model = std::make_unique<WireframeModel>(LoadModel(model_path));
+  loaded.directions = DominantDirections(*loaded.model);
   try {
     loaded.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*loaded.model));
     loaded.regions = std::make_unique<ViewInvariantRegions>(
@@ -139,6 +166,26 @@ const Localizer& LocalizerCache::Get(const std::string& model_path, const std::s
   auto localizer = std::make_unique<Localizer>(*model.model, model.regions.get(), model.area.get(),
                                                cam->second, options_);
   return *localizers_.emplace(key, std::move(localizer)).first->second;
+}
+
+const GlobalLocalizer& LocalizerCache::GetGlobal(const std::string& model_path,
+                                                 const std::string& camera_path,
+                                                 const std::string& camera_name) {
+  const std::string key = model_path + "\n" + camera_path + "\n" + camera_name;
+  auto it = globals_.find(key);
+  if (it != globals_.end()) return *it->second;
+  const Localizer& localizer = Get(model_path, camera_path, camera_name);
+  const LoadedModel& model = Model(model_path);
+  if (!model.area) {
+    throw InputError(model_path + ": the global mode needs a navigable area (" +
+                     model.area_problem + ")");
+  }
+  if (model.directions.angles.empty()) {
+    throw InputError(model_path + ": the global mode needs horizontal model edges");
+  }
+  auto global =
+      std::make_unique<GlobalLocalizer>(localizer, model.directions, GlobalOptionsFor(options_));
+  return *globals_.emplace(key, std::move(global)).first->second;
 }
 
 }  // namespace linetrack::app

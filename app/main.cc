@@ -74,6 +74,10 @@ int main(int argc, char** argv) {
   app::AddModelImport(cli, &action);
   app::AddBenchBuilding(cli, &action);
   app::AddBenchMount(cli, &action);
+  app::AddHeading(cli, &action);
+  app::AddBenchHeading(cli, &action);
+  app::AddViews(cli, &action);
+  app::AddBenchViews(cli, &action);
 
   try {
     cli.parse(argc, argv);

@@ -1,5 +1,6 @@
 # The project's parts and what each may depend on, for its #includes and its links alike.
-# Production (the robot's libraries): models <- calibration, matching <- tracking <- app.
+# Production (the robot's libraries): models <- calibration, matching <- tracking <- app, with
+# heading and views (matching/) beside matching and global (matching/) above the three.
 # Beside them, parts only app/ and tests/ use: render, synth (models/), evaluation (matching/),
 # sim, fake_gige (tracking/); app/bench/ and tests/support/ sit at the top with app/ and tests/.
 # Part P is the folder below and the library linetrack_P. Used at configure time
@@ -9,7 +10,8 @@
 set(LINETRACK_PART_FOLDERS
     "models/render/=render" "models/synth/=synth" "models/import/=import" "models/=models"
     "calibration/=calibration"
-    "matching/evaluation/=evaluation" "matching/=matching"
+    "matching/evaluation/=evaluation" "matching/heading/=heading" "matching/views/=views"
+    "matching/global/=global" "matching/=matching"
     "tracking/sim/=sim" "tracking/fake_gige/=fake_gige" "tracking/=tracking"
     "app/=app" "tests/=tests")
 
@@ -17,6 +19,9 @@ set(LINETRACK_PART_FOLDERS
 set(LINETRACK_DEPS_models models)
 set(LINETRACK_DEPS_calibration calibration models)
 set(LINETRACK_DEPS_matching matching models)
+set(LINETRACK_DEPS_heading heading models)
+set(LINETRACK_DEPS_views views models)
+set(LINETRACK_DEPS_global global matching heading views models)
 set(LINETRACK_DEPS_tracking tracking matching models)
 set(LINETRACK_DEPS_import import models)
 set(LINETRACK_DEPS_render render models)
@@ -25,7 +30,8 @@ set(LINETRACK_DEPS_evaluation evaluation matching render synth models)
 set(LINETRACK_DEPS_sim sim tracking matching render models)
 set(LINETRACK_DEPS_fake_gige fake_gige)
 set(LINETRACK_CHECKED_PARTS
-    models import calibration matching tracking render synth evaluation sim fake_gige)
+    models import calibration matching heading views global tracking render synth evaluation sim
+    fake_gige)
 
 # Sets `out` to the part of the project path `path` (e.g. "matching/lines/x.h" -> matching), or
 # to "" when the path is in none.

@@ -18,10 +18,13 @@
 #include "app/model_loading.h"
 #include "matching/evaluation/baseline_sampler.h"
 #include "matching/evaluation/diagnosis.h"
+#include "matching/global/global_localizer.h"
+#include "matching/heading/model_directions.h"
 #include "matching/localizer.h"
 #include "models/errors.h"
 #include "models/statistics.h"
 #include "models/synth/synthetic_scenes.h"
+#include "models/text_format.h"
 
 namespace linetrack::app {
 namespace {
@@ -33,6 +36,8 @@ struct Series {
   // The paper's Table 3 for this prior (out of 430): correct, no answer, wrong but accurate,
   // wrong; negative when the paper has no such series.
   int paper[4] = {-1, -1, -1, -1};
+  // No prior: the scenes' priors are ignored and the global mode localises (docs/global.md).
+  bool global = false;
 };
 
 struct BenchMatchOptions {
@@ -55,7 +60,8 @@ Series SeriesByName(const std::string& name) {
   if (name == "qi2") return {"QI2 (0.50 m, 15 deg)", 0.50, 15.0, {418, 5, 7, 0}};
   if (name == "qi3") return {"QI3 (0.75 m, 20 deg)", 0.75, 20.0, {415, 5, 7, 3}};
   if (name == "wide") return {"wide (2.00 m, 45 deg)", 2.00, 45.0, {-1, -1, -1, -1}};
-  throw InputError("--series: unknown series '" + name + "' (qi1, qi2, qi3, wide)");
+  if (name == "global") return {"global (no prior)", 0.30, 10.0, {-1, -1, -1, -1}, true};
+  throw InputError("--series: unknown series '" + name + "' (qi1, qi2, qi3, wide, global)");
 }
 
 // Outcome counts and figures of one matcher on one series.
@@ -273,6 +279,96 @@ std::string Row(const std::string& matcher, const Tally& t) {
   return row.str();
 }
 
+// One scene of the global series for --diagnose: the truth verified in a search centred on its
+// own heading (its evidence, as the matcher would score it) against every search's finalists,
+// and how far the truth's heading is from the nearest search's.
+nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const Localizer& tree,
+                                           const SyntheticScene& scene, const GlobalResult& r,
+                                           Outcome outcome) {
+  HeadingSearch at_truth;
+  at_truth.heading = scene.truth.heading;
+  at_truth.heading_bound = DegToRad(GlobalOptions().min_heading_bound_deg);
+  const TruthDiagnosis d =
+      DiagnoseTruth(tree, global.SearchProblem({scene.lines, scene.height, scene.tilt}, at_truth),
+                    scene.truth.Planar(), scene.matches);
+  double nearest_deg = 180.0;
+  nlohmann::ordered_json searches = nlohmann::ordered_json::array();
+  for (const HeadingSearch& s : r.searches) {
+    nearest_deg =
+        std::min(nearest_deg, std::abs(RadToDeg(WrapAngle(s.heading - scene.truth.heading))));
+    nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
+    for (const Finalist& f : s.result.finalists) {
+      std::set<int> lines;
+      for (const auto& m : f.matches)
+        lines.insert(m.second);
+      finalists.push_back({f.pose.x, f.pose.y, RadToDeg(WrapAngle(f.pose.heading)),
+                           f.evidence.Score(), f.matched_edges, f.evidence.Support(), lines.size(),
+                           f.evidence.lines_nats, f.evidence.edges_nats});
+    }
+    searches.push_back({{"heading_deg", RadToDeg(WrapAngle(s.heading))},
+                        {"bound_deg", RadToDeg(s.heading_bound)},
+                        {"found", s.result.found},
+                        {"reason", s.result.reason},
+                        {"budget_exhausted", s.result.budget_exhausted},
+                        {"completed_bound", s.result.tree_completed_bound},
+                        {"unexplained_bound", s.result.unexplained_completed_bound},
+                        {"finalists", finalists}});
+  }
+  return {{"scene", scene.index},
+          {"outcome", MatchOutcomeName(outcome)},
+          {"ambiguous", r.ambiguous},
+          {"reason", r.reason},
+          {"truth_pose", {scene.truth.x, scene.truth.y, RadToDeg(WrapAngle(scene.truth.heading))}},
+          {"truth_heading_off_deg", nearest_deg},
+          {"truth_plausible", d.plausible},
+          {"truth_implausible_because", d.implausible_because},
+          {"truth_matched_edges", d.matched_edges},
+          {"truth_evidence", d.evidence_score},
+          {"lines", scene.lines.size()},
+          {"searches", searches}};
+}
+
+// The global mode on a series' scenes, their priors ignored (scenes not in `only`, when given,
+// skipped): the tally and, in *ambiguous, the unanswered scenes answered "ambiguous"; each
+// scene's diagnosis appended to `diagnosis` when given.
+Tally RunGlobalSeries(const Localizer& tree, const ModelDirections& directions,
+                      const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
+                      int* ambiguous, std::ostringstream* diagnosis) {
+  const GlobalLocalizer global(tree, directions, GlobalOptionsFor(tree.options()));
+  Tally tally;
+  for (const SyntheticScene& scene : scenes) {
+    if (!only.empty() && std::find(only.begin(), only.end(), scene.index) == only.end()) continue;
+    const auto start = std::chrono::steady_clock::now();
+    const GlobalResult r = global.Localize({scene.lines, scene.height, scene.tilt});
+    const double ms = MillisecondsSince(start);
+    LocalizationResult shown = r.found ? r.best : LocalizationResult();
+    shown.hypotheses = 0;
+    for (const HeadingSearch& h : r.searches)
+      shown.hypotheses += h.result.hypotheses;
+    const Outcome outcome = Score(scene, shown, ms, &tally);
+    *ambiguous += r.ambiguous ? 1 : 0;
+    if (diagnosis != nullptr) {
+      nlohmann::ordered_json j = GlobalDiagnosisJson(global, tree, scene, r, outcome);
+      j["ms"] = ms;
+      *diagnosis << j.dump() << "\n";
+    }
+  }
+  return tally;
+}
+
+// The table row of the global series, and its note (correct by the confidence region only,
+// ambiguous answers) appended to *notes.
+std::string GlobalRow(const Localizer& tree, const ModelDirections& directions,
+                      const std::vector<SyntheticScene>& scenes, const std::vector<int>& only,
+                      const std::string& name, std::ostringstream* notes,
+                      std::ostringstream* diagnosis) {
+  int ambiguous = 0;
+  const Tally t = RunGlobalSeries(tree, directions, scenes, only, &ambiguous, diagnosis);
+  *notes << (notes->tellp() > 0 ? "; " : "") << name << ": " << t.correct_beyond_tolerance
+         << " (no answer: " << ambiguous << " ambiguous)";
+  return "| " + name + " " + Row("heading + tree", t) + "\n";
+}
+
 // The set-up line and the head of the table.
 std::string TableHeader(const BenchMatchOptions& opt) {
   std::ostringstream table;
@@ -306,6 +402,7 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
   const WireframeModel model = LoadModel(opt.model_path);
   const NavigableArea area = NavigableArea::FromModel(model);
   const ViewInvariantRegions regions = ViewInvariantRegions::Build(model, area);
+  const ModelDirections directions = DominantDirections(model);
   std::vector<Series> series;
   for (const std::string& name : opt.series)
     series.push_back(SeriesByName(name));
@@ -328,6 +425,10 @@ int RunBenchMatch(const BenchMatchOptions& opt) {
     baseline_sampling.max_samples = opt.baseline_samples;
     baseline_options.sampler = BaselineSampler(baseline_sampling);
     const Localizer tree(model, &regions, &area, scene_options.camera, tree_options);
+    if (s.global) {
+      table << GlobalRow(tree, directions, scenes, opt.only, s.name, &beyond, diagnosis.get());
+      continue;
+    }
     const Localizer baseline(model, &regions, &area, scene_options.camera, baseline_options);
     Tally tree_tally, baseline_tally;
     std::map<std::string, int> categories;
@@ -399,7 +500,8 @@ void AddBenchMatch(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--model", opt->model_path, "Model")->capture_default_str();
   cmd->add_option("--count", opt->count, "Scenes per series")->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the scenes")->capture_default_str();
-  cmd->add_option("--series", opt->series, "Priors: qi1 qi2 qi3 wide")->capture_default_str();
+  cmd->add_option("--series", opt->series, "Priors: qi1 qi2 qi3 wide, or global (no prior)")
+      ->capture_default_str();
   cmd->add_flag("!--no-baseline", opt->baseline, "Skip the baseline matcher");
   cmd->add_option("--baseline-samples", opt->baseline_samples,
                   "Random pairs the baseline may draw per case")

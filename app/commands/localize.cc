@@ -1,5 +1,5 @@
-// `linetrack localize`: camera pose from image line segments and a rough prior, one case from
-// flags or many from a JSON-lines batch file.
+// `linetrack localize`: camera pose from image line segments and a rough prior, or with no prior
+// at all (--global), one case from flags or many from a JSON-lines batch file.
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -36,6 +36,7 @@ struct LocalizeOptions {
   double floor_z = std::numeric_limits<double>::quiet_NaN();
   std::string method = "tree";
   bool json = false;
+  bool global = false;  // no prior: heading candidates searched over the whole navigable area
   // From an image (--image) instead of --lines: the line extractor's flags and an overlay.
   std::string image_path, overlay_path;
   LineFlags lines;
@@ -72,6 +73,7 @@ void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
                     nlohmann::ordered_json* json) {
   (*json)["found"] = false;
   (*json)["answer"] = result.finalists.size() > 1 ? "ambiguous" : "none";
+  if (json->contains("ambiguous")) (*json)["ambiguous"] = result.finalists.size() > 1;  // global
   (*json)["reason"] = "the answer is not within the alert limit: " + u.reason;
   (*json)["candidate"] = (*json)["pose"];
   (*json)["pose"] = nullptr;
@@ -85,6 +87,25 @@ void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
                       {"mean_distance_px", f.mean_distance_px}});
   }
   (*json)["rivals"] = rivals;
+}
+
+// Why a global answer from line segments alone is no answer: the global mode's verification can
+// accept a wrong pose where the building repeats itself (docs/global.md), and only the image's
+// integrity check (--image) can tell.
+constexpr const char* kUnverifiedGlobal =
+    "a global answer from line segments alone is not verified: give the image (--image) so "
+    "that its integrity is checked";
+
+// A found global answer without an image becomes a candidate: "found" false, "answer"
+// "unverified", the pose moved to "candidate".
+void MarkUnverified(nlohmann::ordered_json* json) {
+  if (!(*json)["found"].get<bool>()) return;
+  (*json)["found"] = false;
+  (*json)["answer"] = "unverified";
+  (*json)["reason"] = kUnverifiedGlobal;
+  (*json)["candidate"] = (*json)["pose"];
+  (*json)["pose"] = nullptr;
+  (*json)["cMo"] = nullptr;
 }
 
 LocalizerOptions MatcherOptions(const LocalizeOptions& opt) {
@@ -124,6 +145,18 @@ int RunBatch(const LocalizeOptions& opt) {
       const nlohmann::json json = nlohmann::json::parse(row);
       if (json.is_object() && json.contains("id")) id = json["id"];
       BatchCase c = ParseBatchCase(json, base_dir);
+      if (c.global) {
+        const GlobalLocalizer& global = cache.GetGlobal(c.model_path, c.camera_path, c.camera_name);
+        const WireframeModel& model = *cache.Model(c.model_path).model;
+        const double z = CameraZ(model, c.problem.height, c.storey, c.floor_z);
+        const auto start = std::chrono::steady_clock::now();
+        const GlobalResult result = global.Localize({c.problem.lines, z, c.problem.tilt});
+        nlohmann::ordered_json json =
+            GlobalResultToJson(id, result, MillisecondsSince(start), &model);
+        MarkUnverified(&json);
+        std::cout << json.dump() << "\n";
+        continue;
+      }
       const Localizer& localizer = cache.Get(c.model_path, c.camera_path, c.camera_name);
       c.problem.height = CameraZ(localizer.model(), c.problem.height, c.storey, c.floor_z);
       const auto start = std::chrono::steady_clock::now();
@@ -152,6 +185,22 @@ int RunBatch(const LocalizeOptions& opt) {
   return kExitOk;
 }
 
+// Prints an answer with no prior: the pose (PrintResult) or why none, with the rival poses.
+void PrintGlobal(const GlobalResult& global, double ms) {
+  std::cout << "global    " << global.searches.size() << " heading searches (";
+  for (size_t i = 0; i < global.searches.size(); ++i) {
+    std::cout << (i ? " " : "") << std::fixed << std::setprecision(1)
+              << RadToDeg(WrapAngle(global.searches[i].heading));
+  }
+  std::cout << " deg)\n";
+  if (global.found) return;
+  std::cout << "no pose: " << global.reason << " (" << std::setprecision(2) << ms << " ms)\n";
+  for (const Pose3Dof& p : global.rivals) {
+    std::cout << "rival     x " << std::setprecision(3) << p.x << " m, y " << p.y << " m, heading "
+              << std::setprecision(2) << RadToDeg(WrapAngle(p.heading)) << " deg\n";
+  }
+}
+
 // The result as text: the pose and each match with its edge's name, or why there is none.
 void PrintResult(const LocalizationResult& result, const WireframeModel& model, double ms) {
   if (result.found) {
@@ -176,9 +225,11 @@ void PrintResult(const LocalizationResult& result, const WireframeModel& model, 
 int RunSingle(const LocalizeOptions& opt) {
   CheckHeight(opt.height, "--height");
   LocalizationProblem problem;
-  problem.prior = ParsePrior(opt.prior_text, "--prior");
-  problem.delta_t = opt.delta_t;
-  problem.delta_phi = DegToRad(opt.delta_phi_deg);
+  if (!opt.global) {
+    problem.prior = ParsePrior(opt.prior_text, "--prior");
+    problem.delta_t = opt.delta_t;
+    problem.delta_phi = DegToRad(opt.delta_phi_deg);
+  }
   problem.height = opt.height;
   problem.tilt = DegToRad(opt.tilt_deg);
   const std::string& source = opt.image_path.empty() ? opt.lines_path : opt.image_path;
@@ -191,28 +242,39 @@ int RunSingle(const LocalizeOptions& opt) {
     problem.lines = ReadLinesCsv(opt.lines_path);
   }
   try {
-    if (!problem.lines.empty()) CheckProblem(problem);
+    if (!problem.lines.empty() && !opt.global) CheckProblem(problem);
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
   const IntegrityOptions integrity_options = opt.integrity.Options();
   LocalizerCache cache(MatcherOptions(opt));
   const Localizer& localizer = cache.Get(opt.model_path, opt.camera_path, opt.camera_name);
+  const GlobalLocalizer* global =
+      opt.global ? &cache.GetGlobal(opt.model_path, opt.camera_path, opt.camera_name) : nullptr;
   problem.height = CameraZ(localizer.model(), opt.height, opt.storey, opt.floor_z);
   const auto start = std::chrono::steady_clock::now();
   LocalizationResult result;
-  if (problem.lines.empty()) {
-    result.reason = "no line segments in the image";  // an image may show none: not bad input
-  } else {
-    result = localizer.Localize(problem);
+  std::optional<GlobalResult> global_result;
+  try {
+    if (problem.lines.empty()) {
+      result.reason = "no line segments in the image";  // an image may show none: not bad input
+    } else if (global) {
+      global_result = global->Localize({problem.lines, problem.height, problem.tilt});
+      result = global_result->found ? global_result->best : LocalizationResult();
+      result.reason = global_result->reason;
+    } else {
+      result = localizer.Localize(problem);
+    }
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
   }
   const double ms = MillisecondsSince(start);
   std::optional<PoseUncertainty> integrity;
   if (image && result.found) {
     integrity = CheckAnswer(opt, *image, problem, result, integrity_options);
   }
-  const bool answered =
-      result.found && (!integrity || integrity->status == IntegrityStatus::kTracking);
+  const bool answered = result.found && (integrity ? integrity->status == IntegrityStatus::kTracking
+                                                   : !global_result);
   if (image && !opt.overlay_path.empty()) {
     WriteFileAtomically(
         opt.overlay_path,
@@ -222,9 +284,12 @@ int RunSingle(const LocalizeOptions& opt) {
     std::cout << "lines     " << image->segments.size() << " segments (" << image->detector << ", "
               << std::fixed << std::setprecision(2) << image->ms << " ms)\n";
   }
+  if (global_result && !opt.json) PrintGlobal(*global_result, ms);
   if (opt.json) {
-    nlohmann::ordered_json json = ResultToJson(std::filesystem::path(source).stem().string(),
-                                               result, ms, cache.Model(opt.model_path).model.get());
+    const std::string id = std::filesystem::path(source).stem().string();
+    const WireframeModel* model = cache.Model(opt.model_path).model.get();
+    nlohmann::ordered_json json = global_result ? GlobalResultToJson(id, *global_result, ms, model)
+                                                : ResultToJson(id, result, ms, model);
     if (image) {
       json["lines"] = image->segments.size();
       json["lines_ms"] = image->ms;
@@ -232,15 +297,22 @@ int RunSingle(const LocalizeOptions& opt) {
     if (integrity) {
       json["integrity"] = UncertaintyJson(*integrity);
       if (!answered) WithholdAnswer(result, *integrity, &json);
+    } else if (global_result) {
+      MarkUnverified(&json);
     }
     std::cout << json.dump(2) << std::endl;
+  } else if (result.found && !integrity && global_result) {
+    std::cout << "no answer: the candidate (x " << std::fixed << std::setprecision(3)
+              << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
+              << RadToDeg(WrapAngle(result.pose.heading)) << " deg) is " << kUnverifiedGlobal
+              << "\n";
   } else if (result.found && !answered) {
     std::cout << "no answer: the pose found (x " << std::fixed << std::setprecision(3)
               << result.pose.x << ", y " << result.pose.y << ", heading " << std::setprecision(2)
               << RadToDeg(WrapAngle(result.pose.heading))
               << " deg) is not within the alert limit: " << integrity->reason << " ("
               << result.finalists.size() << " rivals)\n";
-  } else {
+  } else if (result.found || !global_result) {  // a global failure: PrintGlobal said why
     PrintResult(result, *cache.Model(opt.model_path).model, ms);
     if (integrity && result.found) {
       std::cout << std::fixed << std::setprecision(3) << "integrity " << ToString(integrity->status)
@@ -279,6 +351,9 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
                   "Relative focal-length uncertainty of the camera file")
       ->capture_default_str();
   cmd->add_option("--prior", opt->prior_text, "Prior pose X,Y,HEADING_DEG (metres, degrees)");
+  cmd->add_flag("--global", opt->global,
+                "No prior: anywhere in the navigable area, any heading, instead of --prior, "
+                "--delta-t and --delta-phi (docs/global.md)");
   cmd->add_option("--delta-t", opt->delta_t, "Prior position bound (metres)")
       ->capture_default_str();
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Prior heading bound (degrees)")
@@ -311,7 +386,15 @@ void AddLocalize(CLI::App& cli, CommandAction* action) {
       *action = [opt] { return RunBatch(*opt); };
       return;
     }
-    for (const char* flag : {"--model", "--camera", "--prior", "--height", "--tilt"}) {
+    for (const char* flag : {"--prior", "--delta-t", "--delta-phi"}) {
+      if (opt->global && cmd->count(flag) > 0) {
+        throw CLI::ValidationError(flag, "is not given with --global");
+      }
+    }
+    if (!opt->global && cmd->count("--prior") == 0) {
+      throw CLI::ValidationError("--prior", "required without --batch or --global");
+    }
+    for (const char* flag : {"--model", "--camera", "--height", "--tilt"}) {
       if (cmd->count(flag) == 0) throw CLI::ValidationError(flag, "required without --batch");
     }
     if (cmd->count("--lines") + cmd->count("--image") != 1) {

@@ -2,10 +2,13 @@
 // order (malformed ones with an `error`, the others localised) and echoes each id as given, an
 // unreadable batch exits 2 with one line, and the single-case form prints the batch's JSON keys,
 // takes replay's prior bounds by default, names the matched edges, reads a ROS camera_info as
-// its camera and refuses bad heights and flags that cannot apply.
+// its camera and refuses bad heights and flags that cannot apply. The global mode (no prior): a
+// batch case with "prior": null and the --global flags find a case's true pose, and --global with
+// a prior is refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -52,7 +55,11 @@ TEST_F(LocalizeCli, MalformedCasesGetAnErrorAndTheOthersAreAnswered) {
         << "\n"
         << variant("unknown-model", [](nlohmann::json& j) { j["model"] = "/nonexistent.cao"; })
         << "\n"
-        << variant("missing-prior", [](nlohmann::json& j) { j.erase("prior"); }) << "\n"
+        << variant("bad-prior",
+                   [](nlohmann::json& j) {
+                     j["prior"] = {1.0, 2.0};
+                   })
+        << "\n"
         << variant("missing-tilt", [](nlohmann::json& j) { j.erase("tilt"); }) << "\n"
         << "\n"  // blank: skipped
         << "{\"id\": \"not-json\", \"lines\": [1, 2,\n"
@@ -75,7 +82,7 @@ TEST_F(LocalizeCli, MalformedCasesGetAnErrorAndTheOthersAreAnswered) {
       {"nan", "not a number"},
       {"zero-length", "zero-length"},
       {"unknown-model", "/nonexistent.cao"},
-      {"missing-prior", "prior"},
+      {"bad-prior", "prior"},
       {"missing-tilt", "tilt"},
       {"line-9", "not valid JSON"},
       {"line-10", "JSON object"},
@@ -319,6 +326,91 @@ TEST_F(LocalizeSingleCli, GlobalFlagsWorkAfterTheSubcommand) {
   const CommandRun unknown = Linetrack("localize " + args + " --no-such-flag");
   EXPECT_EQ(unknown.code, 2);
   EXPECT_NE(unknown.err.find("--no-such-flag"), std::string::npos) << unknown.err;
+}
+
+// A pose of the global mode this close to the truth is correct (the benchmarks' tolerance,
+// app/match_outcome.h).
+constexpr double kGlobalPositionTolM = 0.5;
+constexpr double kGlobalHeadingTolDeg = 5.0;
+
+// Scene 4 of the hall's synthetic scenes of seed 17: `bench match --series global` answers it
+// with a clear margin (docs/global.md). Its case with "prior": null, and its truth.
+struct GlobalCase {
+  nlohmann::json json, truth;
+  std::string synth;
+};
+
+class LocalizeGlobalCli : public LocalizeCli {
+ protected:
+  GlobalCase MakeGlobalCase() {
+    GlobalCase gc;
+    gc.synth = (dir_ / "synth").string();
+    EXPECT_EQ(Linetrack("synth --model " + kSource + "/models/hall.cao --out " + gc.synth +
+                        " --count 5 --seed 17")
+                  .code,
+              0);
+    std::ifstream cases(gc.synth + "/cases.jsonl"), truths(gc.synth + "/truth.jsonl");
+    std::string row, truth;
+    for (int i = 0; i < 5; ++i) {
+      std::getline(cases, row);
+      std::getline(truths, truth);
+    }
+    gc.json = nlohmann::json::parse(row);
+    gc.json["prior"] = nullptr;
+    gc.truth = nlohmann::json::parse(truth)["pose"];
+    return gc;
+  }
+
+  // A global answer from lines alone: no pose, but its unverified candidate within the
+  // tolerance of the truth.
+  static void ExpectCandidateAtTheTruth(const nlohmann::json& result, const nlohmann::json& truth) {
+    ASSERT_FALSE(result["found"].get<bool>()) << result.dump();
+    EXPECT_TRUE(result["global"].get<bool>());
+    EXPECT_EQ(result["answer"], "unverified") << result.dump();
+    EXPECT_TRUE(result["pose"].is_null()) << result.dump();
+    const nlohmann::json& pose = result["candidate"];
+    EXPECT_LE(std::hypot(pose["x"].get<double>() - truth["x"].get<double>(),
+                         pose["y"].get<double>() - truth["y"].get<double>()),
+              kGlobalPositionTolM)
+        << result.dump();
+    const double heading = std::remainder(
+        pose["heading_deg"].get<double>() - truth["heading_deg"].get<double>(), 360.0);
+    EXPECT_LE(std::abs(heading), kGlobalHeadingTolDeg) << result.dump();
+  }
+};
+
+TEST_F(LocalizeGlobalCli, BatchCaseWithANullPriorGivesTheTruthAsACandidate) {
+  const GlobalCase gc = MakeGlobalCase();
+  nlohmann::json c = gc.json;
+  c["delta_t"] = "ignored";                             // the bounds are ignored without a prior
+  const std::string path = gc.synth + "/global.jsonl";  // beside the case's camera
+  std::ofstream batch(path);
+  batch << c.dump() << "\n";
+  batch.close();
+  const CommandRun run = Linetrack("localize --batch " + path);
+  ASSERT_EQ(run.code, 0) << run.err;
+  ExpectCandidateAtTheTruth(nlohmann::json::parse(run.out), gc.truth);
+}
+
+TEST_F(LocalizeGlobalCli, GlobalFlagGivesTheTruthAsACandidateAndRefusesAPrior) {
+  const GlobalCase gc = MakeGlobalCase();
+  std::ofstream csv(dir_ / "lines.csv");
+  for (const auto& l : gc.json["lines"])
+    csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+  csv.close();
+  std::ostringstream flags;
+  flags << "localize --global --model " << kSource << "/models/hall.cao --camera " << gc.synth
+        << "/camera.xml --lines " << (dir_ / "lines.csv").string() << " --height "
+        << gc.json["height"] << " --tilt " << gc.json["tilt"];
+  const CommandRun run = Linetrack(flags.str() + " --json");
+  ASSERT_EQ(run.code, 1) << run.err;
+  ExpectCandidateAtTheTruth(nlohmann::json::parse(run.out), gc.truth);
+  for (const std::string flag : {"--prior 1,2,3", "--delta-t 1", "--delta-phi 10"}) {
+    const CommandRun refused = Linetrack(flags.str() + " " + flag);
+    EXPECT_EQ(refused.code, 2) << flag;
+    EXPECT_NE(refused.err.find(flag.substr(0, flag.find(' '))), std::string::npos) << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  }
 }
 
 }  // namespace
