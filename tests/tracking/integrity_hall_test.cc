@@ -164,10 +164,18 @@ TEST(IntegrityHall, DefaultNoiseModelIsCalibratedAndKeepsIntegrity) {
   EXPECT_LE(f.pose.median_sigma, kMaxSigmaToError * f.pose.median_error);
   EXPECT_EQ(f.integrity_failures, 0);
   EXPECT_GE(f.tracking, kMinTracking);
-  const HallFigures defaults = Score(IntegrityOptions());
-  Print("default considered uncertainties", defaults);
-  EXPECT_EQ(defaults.integrity_failures, 0);
-  EXPECT_GE(defaults.pose.shares[3], kMin999Share);
+  for (const auto handling :
+       {ConsideredUncertainty::Handling::kConsider, ConsideredUncertainty::Handling::kEstimate}) {
+    IntegrityOptions options;
+    options.solver.considered.intrinsics = options.solver.considered.mount = handling;
+    const HallFigures defaults = Score(options);
+    Print(handling == ConsideredUncertainty::Handling::kEstimate
+              ? "default uncertainties, estimated"
+              : "default uncertainties, considered",
+          defaults);
+    EXPECT_EQ(defaults.integrity_failures, 0);
+    EXPECT_GE(defaults.pose.shares[3], kMin999Share);
+  }
 }
 
 // Simpler models (docs/integrity.md, sections 1.5 and 4) are overconfident on the same frames:
