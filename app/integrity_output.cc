@@ -53,6 +53,14 @@ nlohmann::ordered_json CovarianceJson(const PoseUncertainty& u) {
   return rows;
 }
 
+// "estimate" or "consider" (--held-parameters).
+ConsideredUncertainty::Handling ParseHandling(const std::string& word) {
+  if (word == "estimate") return ConsideredUncertainty::Handling::kEstimate;
+  if (word == "consider") return ConsideredUncertainty::Handling::kConsider;
+  throw InputError("--held-parameters: '" + word +
+                   "' is neither 'estimate' nor 'consider' (give one, or INTRINSICS,MOUNT)");
+}
+
 }  // namespace
 
 IntegrityOptions IntegrityFlags::Options(const IntegrityOptions& base) const {
@@ -75,6 +83,13 @@ IntegrityOptions IntegrityFlags::Options(const IntegrityOptions& base) const {
   options.solver.noise.model_sigma_m = model_sigma_m;
   CheckRange(casing_sigma_m, 0.0, 1.0, "--casing-sigma");
   options.solver.noise.casing_sigma_m = casing_sigma_m;
+  if (!held_parameters.empty()) {
+    const size_t comma = held_parameters.find(',');
+    ConsideredUncertainty& c = options.solver.considered;
+    c.intrinsics = ParseHandling(held_parameters.substr(0, comma));
+    c.mount = comma == std::string::npos ? c.intrinsics
+                                         : ParseHandling(held_parameters.substr(comma + 1));
+  }
   CheckRange(edge_fault_prior, 0.0, 0.5, "--edge-fault-prior");
   options.edge_fault_probability = edge_fault_prior;
   std::string why;
@@ -102,6 +117,11 @@ void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags) {
                   "Prior probability that one edge's points are wrong beyond the noise (latched "
                   "on an unmodelled line): the protection levels cover such a fault")
       ->capture_default_str();
+  cmd->add_option("--held-parameters", flags->held_parameters,
+                  "What the pose solve does with the intrinsics and the camera's height, tilt "
+                  "and roll: 'estimate' them with the pose under their stated uncertainty, or "
+                  "'consider' them (held at nominal, their uncertainty widening the covariance); "
+                  "one word for both or INTRINSICS,MOUNT (default estimate)");
 }
 
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags) {

@@ -22,14 +22,17 @@ struct IntegrityFlags {
   double model_sigma_m = EdgeNoiseOptions().model_sigma_m;
   double casing_sigma_m = EdgeNoiseOptions().casing_sigma_m;
   double edge_fault_prior = IntegrityOptions().edge_fault_probability;
+  // What the solve does with the intrinsics and the mount's height, tilt and roll: "estimate"
+  // or "consider" for both, or "INTRINSICS,MOUNT" (e.g. "consider,estimate"); empty: the default.
+  std::string held_parameters;
   bool all_poses = false;  // poses.txt: every pose, not only those tracking
 
   // The options they set on `base`. Throws InputError naming the flag when malformed.
   IntegrityOptions Options(const IntegrityOptions& base = IntegrityOptions()) const;
 };
 
-// Adds --alert-limit, --camera-sigma, --model-sigma, --casing-sigma and --edge-fault-prior to
-// `cmd`; AddAllPosesFlag --all-poses.
+// Adds --alert-limit, --camera-sigma, --model-sigma, --casing-sigma, --edge-fault-prior and
+// --held-parameters to `cmd`; AddAllPosesFlag --all-poses.
 void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags);
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags);
 

@@ -4,6 +4,7 @@
 // scenes whose errors follow the stated model.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
 #include <random>
@@ -38,6 +39,7 @@ constexpr int kMonteCarloRuns = 400;
 constexpr double kMeanNeesTol = 0.12;
 constexpr double kMinScaledMeanNees = 0.75;
 constexpr double kMin99Share = 0.975;
+constexpr double kMinEstimateGain = 0.2;  // share of the position sigma that estimation saves
 
 Eigen::Isometry3d TestFreePose() {
   WorldTwist tilt = WorldTwist::Zero();
@@ -237,10 +239,13 @@ struct MonteCarloFigures {
 };
 
 // Seeded Monte Carlo of the solve: each run draws the camera, the robot's height, tilt and roll
-// and the edge points' errors from `noise`, solves from a start 2 cm / 0.3 degree off, and
-// scores the estimate's NEES with its covariance (and for a robot, the 6 x 6 world twist's).
+// and the edge points' errors from `noise`, solves from a start 2 cm / 0.3 degree off (the held
+// parameters estimated or considered), and scores the estimate's NEES with its covariance (and
+// for a robot, the 6 x 6 world twist's).
+using Handling = ConsideredUncertainty::Handling;
+
 MonteCarloFigures RunMonteCarlo(const SceneNoise& noise, bool free, int seed,
-                                bool estimate_edge_scale) {
+                                bool estimate_edge_scale, Handling handling) {
   const CameraIntrinsics nominal = TestCamera();
   const RobotPose robot = TestRobotPose();
   const PoseParameterisation parameters =
@@ -248,6 +253,7 @@ MonteCarloFigures RunMonteCarlo(const SceneNoise& noise, bool free, int seed,
            : PoseParameterisation(KnownHeightTilt{robot.height, robot.tilt});
   EdgePoseSolverOptions options = SolverOptionsFor(noise);
   options.noise.estimate_edge_scale = estimate_edge_scale;
+  options.considered.intrinsics = options.considered.mount = handling;
   std::mt19937 random(seed);
   CalibrationTally tally(parameters.dof()), world(6);
   for (int run = 0; run < kMonteCarloRuns; ++run) {
@@ -296,26 +302,69 @@ SceneNoise EveryError() {
 }
 
 TEST(EdgePoseSolver, RobotCovarianceMatchesMonteCarloWithEveryError) {
-  for (bool scaled : {false, true}) {
-    const MonteCarloFigures figures = RunMonteCarlo(EveryError(), false, 21, scaled);
-    const std::string how = scaled ? ", lambda estimated" : ", stated model";
-    ExpectCalibrated(figures.unknowns, scaled, "robot x, y, heading" + how);
-    ExpectCalibrated(figures.world, scaled, "robot world twist" + how);
+  for (Handling handling : {Handling::kConsider, Handling::kEstimate}) {
+    for (bool scaled : {false, true}) {
+      const MonteCarloFigures figures = RunMonteCarlo(EveryError(), false, 21, scaled, handling);
+      const std::string how = std::string(handling == Handling::kEstimate ? ", estimated" : "") +
+                              (scaled ? ", lambda estimated" : ", stated model");
+      ExpectCalibrated(figures.unknowns, scaled, "robot x, y, heading" + how);
+      ExpectCalibrated(figures.world, scaled, "robot world twist" + how);
+    }
   }
 }
 
 TEST(EdgePoseSolver, FreeCameraCovarianceMatchesMonteCarloWithEveryError) {
-  for (bool scaled : {false, true}) {
-    ExpectCalibrated(RunMonteCarlo(EveryError(), true, 22, scaled).unknowns, scaled,
-                     scaled ? "free camera, lambda estimated" : "free camera, stated model");
+  for (Handling handling : {Handling::kConsider, Handling::kEstimate}) {
+    for (bool scaled : {false, true}) {
+      const std::string how = std::string(handling == Handling::kEstimate ? ", estimated" : "") +
+                              (scaled ? ", lambda estimated" : ", stated model");
+      ExpectCalibrated(RunMonteCarlo(EveryError(), true, 22, scaled, handling).unknowns, scaled,
+                       "free camera" + how);
+    }
   }
+}
+
+// Solving for the held parameters under their prior gives the marginal covariance
+// (A - B (D + Sc^-1)^-1 B')^-1, never larger than the consider covariance A^-1 + A^-1 B Sc B' A^-1
+// (D = J_c' S^-1 J_c >= B' A^-1 B); in the room, tilt and v0 are seen by the floor lines, so the
+// position sigma shrinks by more than kMinEstimateGain.
+TEST(EdgePoseSolver, EstimatingTheHeldParametersNeverWidensTheCovariance) {
+  const RobotPose robot = TestRobotPose();
+  const PoseParameterisation parameters(KnownHeightTilt{robot.height, robot.tilt});
+  std::mt19937 random(31);
+  EdgePoseSolverOptions options = SolverOptionsFor(EveryError());
+  options.noise.estimate_edge_scale = false;
+  const Eigen::Isometry3d truth = CamFromWorld(robot);
+  const std::vector<EdgeObservation> observations =
+      Observe(RoomEdges(), TestCamera(), truth, EveryError(), &random);
+  options.considered.intrinsics = options.considered.mount = Handling::kConsider;
+  const EdgePoseSolution held =
+      SolveEdgePose(observations, TestCamera(), truth, parameters, options);
+  options.considered.intrinsics = options.considered.mount = Handling::kEstimate;
+  const EdgePoseSolution solved =
+      SolveEdgePose(observations, TestCamera(), truth, parameters, options);
+  ASSERT_TRUE(held.ok && solved.ok);
+  EXPECT_EQ(solved.state_size(), 9);
+  EXPECT_EQ(held.state_size(), 3);
+  const Eigen::VectorXd gain =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(held.covariance - solved.covariance)
+          .eigenvalues();
+  EXPECT_GE(gain.minCoeff(), -1e-9 * held.covariance.norm());
+  EXPECT_LT(LargestSigmas(parameters, solved.covariance)[0],
+            (1.0 - kMinEstimateGain) * LargestSigmas(parameters, held.covariance)[0]);
+  // The marginal is the Schur complement: (A - B (D + Sc^-1)^-1 B')^-1.
+  const Eigen::MatrixXd& z = solved.information;
+  const Eigen::MatrixXd schur = z.topLeftCorner(3, 3) - z.topRightCorner(3, 6) *
+                                                            z.bottomRightCorner(6, 6).inverse() *
+                                                            z.bottomLeftCorner(6, 3);
+  EXPECT_LT((schur.inverse() - solved.covariance).norm(), 1e-9 * solved.covariance.norm());
 }
 
 // Point noise alone: the per-edge model adds nothing and the covariance is the plain one.
 TEST(EdgePoseSolver, RobotCovarianceMatchesMonteCarloWithPointNoiseOnly) {
   SceneNoise noise;
   noise.point_px = 0.2;
-  ExpectCalibrated(RunMonteCarlo(noise, false, 23, true).unknowns, false,
+  ExpectCalibrated(RunMonteCarlo(noise, false, 23, true, Handling::kEstimate).unknowns, false,
                    "robot, point noise only");
 }
 

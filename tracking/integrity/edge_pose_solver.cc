@@ -17,9 +17,10 @@ constexpr double kNearClipM = 0.01;
 constexpr double kMinEigenRatio = 1e-12;  // information below this share of its largest axis
 constexpr int kScaleBisections = 40;
 
-// Small matrices of at most 6 x 6 (pose and considered parameters), on the stack.
-using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+// Small matrices of at most 9 x 9 (the state: pose and estimated parameters; the held
+// parameters), on the stack.
+using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 9, 9>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 9, 1>;
 
 // One edge linearised at a pose: residuals, Jacobians in the unknowns and in the considered
 // parameters, the endpoint basis U (rows (1 - t, t)) and the edge-level covariance; then the
@@ -58,8 +59,9 @@ bool Linearise(const EdgeObservation& observation, const CameraIntrinsics& camer
   if (!(d.squaredNorm() > 1e-12)) return false;
   const EdgeLineProjection line(observation.a, observation.b, pose, camera);
   // d n / d x and d n / d (height, tilt, roll): 3 x dof and 3 x (0 or 3).
-  const Small normal_of_unknowns = line.NormalOfTwist() * parameters.TwistOfUnknowns();
-  const Small normal_of_robot = line.NormalOfTwist() * parameters.TwistOfRobotParameters(pose);
+  using NormalMap = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 6>;
+  const NormalMap normal_of_unknowns = line.NormalOfTwist() * parameters.TwistOfUnknowns();
+  const NormalMap normal_of_robot = line.NormalOfTwist() * parameters.TwistOfRobotParameters(pose);
   const int m = static_cast<int>(observation.points.size());
   out->residuals.resize(m);
   out->jacobian.resize(m, parameters.dof());
@@ -69,10 +71,10 @@ bool Linearise(const EdgeObservation& observation, const CameraIntrinsics& camer
     const Eigen::Vector2d& p = observation.points[i];
     const EdgePointResidual r = line.At(p);
     out->residuals[i] = r.residual;
-    out->jacobian.row(i) = r.d_normal.transpose() * normal_of_unknowns;
+    out->jacobian.row(i).noalias() = r.d_normal.transpose() * normal_of_unknowns;
     out->considered.row(i).head<3>() = r.d_camera;
     if (parameters.robot())
-      out->considered.row(i).tail<3>() = r.d_normal.transpose() * normal_of_robot;
+      out->considered.row(i).tail<3>().noalias() = r.d_normal.transpose() * normal_of_robot;
     const double t = (p - pa).dot(d) / d.squaredNorm();
     out->basis.row(i) << 1.0 - t, t;
   }
@@ -82,6 +84,23 @@ bool Linearise(const EdgeObservation& observation, const CameraIntrinsics& camer
     out->edge_covariance += noise.casing_sigma_m * noise.casing_sigma_m * k * k.transpose();
   }
   return true;
+}
+
+// Moves the estimated parameters' columns of the considered Jacobian J_c into the state's
+// Jacobian and their current deviation c^ into the residuals, r(c^) = r(c0) + J_c c^ (first
+// order: c^ is a fraction of a degree, pixel or per cent); the held columns stay considered.
+void Augment(const EdgePoseSolution& state, EdgeLinearisation* e) {
+  const int dof = static_cast<int>(e->jacobian.cols());
+  const int q = static_cast<int>(state.estimated.size());
+  const Eigen::MatrixXd full = e->considered;
+  e->jacobian.conservativeResize(Eigen::NoChange, dof + q);
+  for (int j = 0; j < q; ++j) {
+    e->jacobian.col(dof + j) = full.col(state.estimated[j]);
+    e->residuals += full.col(state.estimated[j]) * state.parameter_deviation[j];
+  }
+  e->considered.resize(full.rows(), state.held.size());
+  for (size_t j = 0; j < state.held.size(); ++j)
+    e->considered.col(j) = full.col(state.held[j]);
 }
 
 // The residuals of each edge about its own least-squares line (offset and slope in the endpoint
@@ -227,10 +246,10 @@ bool WellConditioned(const Eigen::MatrixXd& information) {
 // The edges' whitened blocks and their sums (information, coupling, gradient, chi2) for the
 // edge-level factor `lambda`.
 void Sum(const std::vector<EdgeSums>& edges, double lambda, EdgePoseSolution* out) {
-  const int dof = out->parameters.dof();
-  out->information = Eigen::MatrixXd::Zero(dof, dof);
-  out->coupling = Eigen::MatrixXd::Zero(dof, out->parameters.considered());
-  out->gradient = Eigen::VectorXd::Zero(dof);
+  const int n = out->state_size();
+  out->information = Eigen::MatrixXd::Zero(n, n);
+  out->coupling = Eigen::MatrixXd::Zero(n, out->held.size());
+  out->gradient = Eigen::VectorXd::Zero(n);
   out->chi2 = 0.0;
   out->edges.clear();
   for (const EdgeSums& e : edges) {
@@ -240,6 +259,27 @@ void Sum(const std::vector<EdgeSums>& edges, double lambda, EdgePoseSolution* ou
     out->gradient += out->edges.back().gradient;
     out->chi2 += out->edges.back().chi2;
   }
+}
+
+// Adds the priors to the sums: the estimated parameters' N(0, Sc) on their deviations c^ (never
+// an edge's, so never downdated) and the pose prior's information on the unknowns.
+void AddPriors(const std::optional<PosePrior>& prior, const Eigen::Isometry3d& pose,
+               const Eigen::MatrixXd& full_considered, EdgePoseSolution* out) {
+  const int dof = out->parameters.dof();
+  for (size_t j = 0; j < out->estimated.size(); ++j) {
+    const int i = out->estimated[j];
+    const double information = 1.0 / full_considered(i, i);
+    const double c = out->parameter_deviation[j];
+    out->information(dof + j, dof + j) += information;
+    out->gradient[dof + j] += information * c;
+    out->chi2 += information * c * c;
+  }
+  if (!prior) return;
+  const Eigen::MatrixXd prior_information = prior->covariance.inverse();
+  const Eigen::VectorXd offset = out->parameters.Difference(pose, prior->cam_from_world);
+  out->information.topLeftCorner(dof, dof) += prior_information;
+  out->gradient.head(dof) += prior_information * offset;
+  out->chi2 += offset.dot(prior_information * offset);
 }
 
 // Linearises every kept observation at `pose` and fills the solution's blocks and sums; false
@@ -260,6 +300,7 @@ bool Assemble(const std::vector<EdgeObservation>& observations, const CameraIntr
       out->reason = "a model edge falls behind the camera";
       return false;
     }
+    Augment(*out, &e);
     out->points += static_cast<int>(e.residuals.size());
     edges.push_back(std::move(e));
   }
@@ -271,10 +312,14 @@ bool Assemble(const std::vector<EdgeObservation>& observations, const CameraIntr
   std::vector<EdgeSums> sums;
   for (const EdgeLinearisation& e : edges)
     sums.push_back(Accumulate(e, out->point_sigma_px));
-  out->considered = options.considered.Covariance(parameters);
+  const Eigen::MatrixXd full_considered = options.considered.Covariance(parameters);
+  out->considered = Eigen::MatrixXd::Zero(out->held.size(), out->held.size());
+  for (size_t j = 0; j < out->held.size(); ++j)
+    out->considered(j, j) = full_considered(out->held[j], out->held[j]);
   out->edge_scale = 1.0;
   if (options.noise.estimate_edge_scale) {
     Sum(sums, 1.0, out);  // lambda needs the lean A^-1 B of the solve at lambda = 1
+    AddPriors(prior, pose, full_considered, out);
     const Eigen::MatrixXd lean = WellConditioned(out->information)
                                      ? Eigen::MatrixXd(out->information.ldlt().solve(out->coupling))
                                      : Eigen::MatrixXd();
@@ -282,13 +327,7 @@ bool Assemble(const std::vector<EdgeObservation>& observations, const CameraIntr
         EstimateEdgeScale(sums, parameters.dof(), lean, out->considered, options.noise);
   }
   Sum(sums, out->edge_scale, out);
-  if (prior) {
-    const Eigen::MatrixXd prior_information = prior->covariance.inverse();
-    const Eigen::VectorXd offset = parameters.Difference(pose, prior->cam_from_world);
-    out->information += prior_information;
-    out->gradient += prior_information * offset;
-    out->chi2 += offset.dot(prior_information * offset);
-  }
+  AddPriors(prior, pose, full_considered, out);
   out->cam_from_world = pose;
   return true;
 }
@@ -311,6 +350,16 @@ Eigen::MatrixXd ConsideredUncertainty::Covariance(const PoseParameterisation& pa
   sigmas.head<3>() << focal_relative, principal_point_px, principal_point_px;
   if (parameters.robot()) sigmas.tail<3>() << height_m, tilt_rad, roll_rad;
   return sigmas.cwiseAbs2().asDiagonal();
+}
+
+std::vector<int> ConsideredUncertainty::Estimated(const PoseParameterisation& parameters) const {
+  const Eigen::MatrixXd covariance = Covariance(parameters);
+  std::vector<int> out;
+  for (int i = 0; i < parameters.considered(); ++i) {
+    const Handling handling = i < 3 ? intrinsics : mount;
+    if (handling == Handling::kEstimate && covariance(i, i) > 0.0) out.push_back(i);
+  }
+  return out;
 }
 
 bool ConsideredUncertainty::Check(std::string* why) const {
@@ -380,6 +429,13 @@ EdgePoseSolution SolveEdgePose(const std::vector<EdgeObservation>& observations,
   EdgePoseSolution out;
   out.parameters = parameters;
   const int dof = parameters.dof();
+  out.estimated = options.considered.Estimated(parameters);
+  for (int i = 0; i < parameters.considered(); ++i) {
+    if (std::find(out.estimated.begin(), out.estimated.end(), i) == out.estimated.end()) {
+      out.held.push_back(i);
+    }
+  }
+  out.parameter_deviation = Eigen::VectorXd::Zero(out.estimated.size());
   Eigen::Isometry3d pose = parameters.Apply(start, Eigen::VectorXd::Zero(dof));
   bool converged = false;
   for (int it = 0;; ++it) {
@@ -394,28 +450,54 @@ EdgePoseSolution SolveEdgePose(const std::vector<EdgeObservation>& observations,
       out.reason = "the Gauss-Newton step failed";
       return out;
     }
-    pose = parameters.Apply(pose, step);
+    pose = parameters.Apply(pose, step.head(dof));
+    out.parameter_deviation += step.tail(out.estimated.size());
     out.iterations = it + 1;
     converged = step.norm() < options.step_tolerance;
   }
-  out.covariance = ConsiderCovariance(out.information, out.coupling, out.considered);
+  out.state_covariance = ConsiderCovariance(out.information, out.coupling, out.considered);
+  out.covariance = out.state_covariance.topLeftCorner(dof, dof);
   out.ok = out.covariance.allFinite();
   if (!out.ok) out.reason = "the edges do not fix the pose";
   return out;
 }
 
+namespace {
+
+// The world twists (6 x indices.size()) of the parameters `indices` (into (s, u0, v0, height,
+// tilt, roll)) at the solution's pose: zero for the intrinsics.
+Eigen::MatrixXd TwistOfParameters(const EdgePoseSolution& solution,
+                                  const std::vector<int>& indices) {
+  const Eigen::MatrixXd robot = solution.parameters.TwistOfRobotParameters(solution.cam_from_world);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(6, indices.size());
+  for (size_t j = 0; j < indices.size(); ++j) {
+    if (indices[j] >= 3) out.col(j) = robot.col(indices[j] - 3);
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::MatrixXd TwistOfState(const EdgePoseSolution& solution) {
+  Eigen::MatrixXd out(6, solution.state_size());
+  out << solution.parameters.TwistOfUnknowns(), TwistOfParameters(solution, solution.estimated);
+  return out;
+}
+
 Eigen::Matrix<double, 6, 6> WorldTwistCovariance(const EdgePoseSolution& solution) {
-  const PoseParameterisation& parameters = solution.parameters;
-  const Eigen::MatrixXd unknowns = parameters.TwistOfUnknowns();
-  Eigen::Matrix<double, 6, 6> covariance = unknowns * solution.covariance * unknowns.transpose();
-  if (!parameters.robot()) return covariance;
-  const Eigen::MatrixXd robot = parameters.TwistOfRobotParameters(solution.cam_from_world);
-  const Eigen::Matrix3d robot_covariance = solution.considered.bottomRightCorner<3, 3>();
-  // e_x = A^-1 B dc + noise, e_c = -dc for the robot's parameters.
+  const Eigen::MatrixXd state = TwistOfState(solution);
+  Eigen::Matrix<double, 6, 6> covariance = state * solution.state_covariance * state.transpose();
+  // The reported pose holds the estimated parameters at nominal: off by -T c^ from the estimate.
+  const WorldTwist offset =
+      TwistOfParameters(solution, solution.estimated) * solution.parameter_deviation;
+  covariance += offset * offset.transpose();
+  // The held robot parameters: e_c = -dc, cov(e_z, e_c) = -A^-1 B S_h.
+  const Eigen::MatrixXd held = TwistOfParameters(solution, solution.held);
+  if (held.isZero()) return covariance;
   const Eigen::MatrixXd cross =
-      -solution.information.inverse() * solution.coupling.rightCols<3>() * robot_covariance;
-  const Eigen::MatrixXd mixed = unknowns * cross * robot.transpose();
-  covariance += robot * robot_covariance * robot.transpose() + mixed + mixed.transpose();
+      -solution.information.ldlt().solve(solution.coupling) * solution.considered;
+  const Eigen::MatrixXd mixed = state * cross * held.transpose();
+  covariance += held * solution.considered * held.transpose() + mixed + mixed.transpose();
   return covariance;
 }
 

@@ -2,7 +2,8 @@
 // edges cannot see (docs/integrity.md, section 1): the points of one model edge share an error
 // (the model is a few millimetres off, a blurred or neighbouring line pulls the moving edges), so
 // each edge's residuals r = J dx + U beta + n are whitened together (Woodbury, 2 x 2 per edge);
-// the intrinsics and a robot's height, tilt and roll enter as consider parameters.
+// the intrinsics and a robot's height, tilt and roll are estimated with the pose under their
+// stated prior, or held at nominal as consider parameters.
 #pragma once
 
 #include <Eigen/Core>
@@ -57,8 +58,19 @@ struct ConsideredUncertainty {
   double tilt_rad = 0.1 * kPi / 180.0;
   double roll_rad = 0.1 * kPi / 180.0;
 
+  // What the solve does with a group of these parameters: hold it at nominal and widen the
+  // covariance by A^-1 B Sc B' A^-1 (consider), or solve for its deviation from nominal with the
+  // pose under the prior N(0, Sc) and report the pose's marginal covariance (estimate), which is
+  // never larger (docs/integrity.md, section 1.4).
+  enum class Handling { kConsider, kEstimate };
+  Handling intrinsics = Handling::kEstimate;  // s, u0, v0
+  Handling mount = Handling::kEstimate;       // a robot's height, tilt, roll
+
   // Diagonal covariance of (s, u0, v0) and, for a robot, (height, tilt, roll).
   Eigen::MatrixXd Covariance(const PoseParameterisation& parameters) const;
+  // Indices into (s, u0, v0, height, tilt, roll) of the parameters solved for: those of an
+  // estimated group with a sigma above 0 (a zero sigma is an exact value).
+  std::vector<int> Estimated(const PoseParameterisation& parameters) const;
   bool Check(std::string* why) const;
 };
 
@@ -80,9 +92,10 @@ struct EdgePoseSolverOptions {
   bool Check(std::string* why) const;
 };
 
-// One edge's whitened normal-equation terms at the solution: information A_e = J' S_e^-1 J,
-// gradient g_e = J' S_e^-1 r, consider coupling B_e = J' S_e^-1 J_c (S_e the edge's residual
-// covariance), chi2_e = r' S_e^-1 r; r, J, J_c at the solution.
+// One edge's whitened normal-equation terms at the solution, in the state (the unknowns, then
+// the estimated parameters' deviations): information A_e = J' S_e^-1 J, gradient g_e =
+// J' S_e^-1 r, consider coupling B_e = J' S_e^-1 J_c with the held parameters (S_e the edge's
+// residual covariance), chi2_e = r' S_e^-1 r; r, J, J_c at the solution.
 struct EdgeBlock {
   int observation = -1;  // index into the solver's input
   int points = 0;
@@ -100,17 +113,28 @@ struct EdgePoseSolution {
   std::string reason;  // why not, when !ok
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
   PoseParameterisation parameters;
+  // The state is the unknowns (parameters.dof()) followed by the deviations from nominal of the
+  // `estimated` parameters (indices into (s, u0, v0, height, tilt, roll)); `held` are considered.
+  // cam_from_world keeps a robot's nominal height, tilt and roll.
+  std::vector<int> estimated, held;
+  Eigen::VectorXd parameter_deviation;  // the estimated parameters' c^ - c0 (state's tail)
   std::vector<EdgeBlock> edges;
-  Eigen::MatrixXd information;  // sum of the edges' (and the prior's)
-  Eigen::VectorXd gradient;     // sum of the edges' (and the prior's); ~0 at the solution
-  Eigen::MatrixXd coupling;     // sum of the edges' B_e
-  Eigen::MatrixXd considered;   // covariance of the considered parameters
-  Eigen::MatrixXd covariance;   // A^-1 + A^-1 B Sc B' A^-1, the unknowns' (dof x dof)
+  // Sums of the edges' terms and the priors' (the pose prior's and the estimated parameters'
+  // N(0, Sc), which no edge carries, so that downdating an edge never removes them).
+  Eigen::MatrixXd information;  // state x state
+  Eigen::VectorXd gradient;     // ~0 at the solution
+  Eigen::MatrixXd coupling;     // sum of the edges' B_e, state x held
+  Eigen::MatrixXd considered;   // covariance of the held parameters
+  // A^-1 + A^-1 B Sc B' A^-1 of the state, and its unknowns' block (dof x dof): the marginal.
+  Eigen::MatrixXd state_covariance;
+  Eigen::MatrixXd covariance;
   double point_sigma_px = 0.0;
   double edge_scale = 1.0;  // lambda
   int points = 0;
   double chi2 = 0.0;  // sum of the edges' chi2_e (and the prior's)
   int iterations = 0;
+
+  int state_size() const { return parameters.dof() + static_cast<int>(estimated.size()); }
 };
 
 // The generalised least-squares pose from `observations` (edges and points, undistorted
@@ -131,11 +155,15 @@ Eigen::MatrixXd ConsiderCovariance(const Eigen::MatrixXd& information,
                                    const Eigen::MatrixXd& coupling,
                                    const Eigen::MatrixXd& considered);
 
-// The covariance (6 x 6) of the world twist (dC, omega) of the solution's pose: for a free camera
-// the unknowns' own; for a robot, the unknowns mapped by TwistOfUnknowns plus the height, tilt
-// and roll's own uncertainty and their correlation with the unknowns (the estimate leans on the
-// nominal height and tilt: e = G_x e_x + G_c e_c with cov(e_x, e_c) = -A^-1 B_c S_c).
+// The covariance (6 x 6) of the world twist (dC, omega) of the solution's pose (nominal height,
+// tilt and roll): e = T e_z - T c^ - G_h dc_h with T = d twist / d state (TwistOfState), c^ the
+// estimated deviations (a known offset: its outer product is added), G_h the held robot
+// parameters' twists, cov(e_z, dc_h) = A^-1 B S_h (the estimate leans on the held values).
 Eigen::Matrix<double, 6, 6> WorldTwistCovariance(const EdgePoseSolution& solution);
+
+// d (dC, omega) / d state at the solution's pose (6 x state_size()): TwistOfUnknowns, then each
+// estimated robot parameter's twist (TwistOfRobotParameters); intrinsics move no pose (zeros).
+Eigen::MatrixXd TwistOfState(const EdgePoseSolution& solution);
 
 // The edge-level covariance of one edge in the endpoint basis (pixels^2), for depths z_a, z_b
 // (metres) and focal length f (pixels): diag((f s_m / z_a)^2, (f s_m / z_b)^2) + s_l^2 [1 1; 1 1].

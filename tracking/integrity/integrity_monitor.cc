@@ -248,11 +248,11 @@ void FaultProbabilities(const EdgePoseSolution& solution, const IntegrityOptions
 
 Eigen::MatrixXd FaultAwareCovariance(const EdgePoseSolution& solution,
                                      const std::vector<EdgeSeparation>& separations) {
-  Eigen::MatrixXd covariance = solution.covariance;
+  Eigen::MatrixXd covariance = solution.state_covariance;
   for (const EdgeSeparation& s : separations) {
     if (!s.observable || !(s.probability_faulty > 0.0)) continue;
-    covariance += s.probability_faulty *
-                  (s.covariance - solution.covariance + s.separation * s.separation.transpose());
+    covariance += s.probability_faulty * (s.covariance - solution.state_covariance +
+                                          s.separation * s.separation.transpose());
   }
   return covariance;
 }
@@ -342,11 +342,12 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
   }
   out.levels = ComputeProtectionLevels(out.solution, separations, options);
   FaultProbabilities(out.solution, options, &separations);
-  out.covariance = FaultAwareCovariance(out.solution, separations);
-  const Eigen::MatrixXd unknowns = parameters.TwistOfUnknowns();
+  const Eigen::MatrixXd state_covariance = FaultAwareCovariance(out.solution, separations);
+  out.covariance = state_covariance.topLeftCorner(parameters.dof(), parameters.dof());
+  const Eigen::MatrixXd state = TwistOfState(out.solution);
   out.world_covariance =
       WorldTwistCovariance(out.solution) +
-      unknowns * (out.covariance - out.solution.covariance) * unknowns.transpose();
+      state * (state_covariance - out.solution.state_covariance) * state.transpose();
   const Eigen::Vector2d sigmas = LargestSigmas(parameters, out.covariance);
   out.position_sigma_m = sigmas[0];
   out.rotation_sigma_rad = sigmas[1];

@@ -48,7 +48,8 @@ struct IntegrityOptions {
   bool Check(std::string* why) const;
 };
 
-// The pose without one edge, to first order from the full solution: information A' = A - A_k,
+// The pose without one edge, to first order from the full solution, in the solution's state
+// (the unknowns and the estimated parameters, whose prior stays): information A' = A - A_k,
 // x_k = x_0* - A'^-1 (g - g_k) (x_0* = x_0 - A^-1 g), its covariance (consider parameters
 // included), and the separation x_0* - x_k with its fault-free covariance (A'^-1 - A^-1) + D Sc
 // D', D = A'^-1 B' - A^-1 B.
@@ -78,9 +79,10 @@ std::vector<EdgeSeparation> SolutionSeparations(const EdgePoseSolution& solution
 void FaultProbabilities(const EdgePoseSolution& solution, const IntegrityOptions& options,
                         std::vector<EdgeSeparation>* separations);
 
-// The covariance of the reported pose averaged over the fault hypotheses (law of total
+// The covariance of the reported state averaged over the fault hypotheses (law of total
 // covariance, as the matcher's DoubtedCovariance): C + sum_k p_k [(C_k - C) + s_k s_k'], the
-// truth being N(x_k, C_k) when edge k is faulty, so that the reported x_0 is off by s_k.
+// truth being N(x_k, C_k) when edge k is faulty, so that the reported x_0 is off by s_k; C the
+// solution's state_covariance.
 Eigen::MatrixXd FaultAwareCovariance(const EdgePoseSolution& solution,
                                      const std::vector<EdgeSeparation>& separations);
 
@@ -109,8 +111,8 @@ struct PoseIntegrity {
   std::string reason;  // why degraded or lost, and which edges were excluded
   // The pose (cam_from_world), the fault-free covariance of the unknowns, the noise scales.
   EdgePoseSolution solution;
-  // The covariance to report (not when lost): the unknowns' (FaultAwareCovariance), and the world
-  // twist's 6 x 6 (WorldTwistCovariance plus the same fault terms).
+  // The covariance to report (not when lost): the unknowns' block of FaultAwareCovariance, and the
+  // world twist's 6 x 6 (WorldTwistCovariance plus the same fault terms).
   Eigen::MatrixXd covariance;
   Eigen::Matrix<double, 6, 6> world_covariance =
       Eigen::Matrix<double, 6, 6>::Constant(std::numeric_limits<double>::infinity());
