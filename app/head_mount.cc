@@ -44,6 +44,7 @@ RobotReading ReadingOnHead(const BelievedHead& head, RobotReading reading, doubl
       CameraPoseOnHead(head.geometry, Pose3Dof{}, head.crossing_height, 0.0, head_tilt);
   reading.height = camera.height;
   reading.tilt = camera.tilt;
+  reading.roll = camera.roll;
   return reading;
 }
 

@@ -27,8 +27,8 @@ struct BelievedHead {
 BelievedHead BelieveHead(HeadModel model, const std::optional<MountFile>& mount,
                          const std::string& mount_path, std::optional<double> taped_height);
 
-// `reading` with the height and tilt of the camera's centre and optical axis on the head at pan
-// 0 and `head_tilt` (neither depends on the base's position or heading); its odometry is kept.
+// `reading` with the height, tilt and roll of the camera's centre and optical axis on the head at
+// pan 0 and `head_tilt` (none depends on the base's position or heading); its odometry is kept.
 RobotReading ReadingOnHead(const BelievedHead& head, RobotReading reading, double head_tilt);
 
 }  // namespace linetrack::app

@@ -62,6 +62,12 @@ RobotPose Full(const Pose3Dof& pose, const VerificationContext& context) {
   return {pose.x, pose.y, pose.heading, context.height, context.tilt};
 }
 
+Eigen::Isometry3d FrustumFromWorld(const Pose3Dof& pose, const VerificationContext& context) {
+  RobotPose rolled = Full(pose, context);
+  rolled.roll = context.roll;
+  return CamFromWorld(rolled);
+}
+
 CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale) {
   CameraIntrinsics c = camera;
   c.px *= scale;
@@ -75,7 +81,7 @@ std::vector<EdgeImage> ProjectEdgesSeenFrom(const VerificationContext& context,
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
   const CameraIntrinsics seen_camera = ScaledCamera(*context.camera, seen_scale);
-  const Eigen::Isometry3d seen_from_world = CamFromWorld(Full(seen, context));
+  const Eigen::Isometry3d seen_from_world = FrustumFromWorld(seen, context);
   const PoseView view = ViewOf(pose, context.height, context.tilt);
   std::vector<EdgeImage> out(context.edges->size());
   for (size_t e = 0; e < out.size(); ++e) {
@@ -100,11 +106,12 @@ std::vector<EdgeImage> ProjectPairedEdges(const VerificationContext& context, co
                                           const std::vector<std::pair<int, int>>& pairs) {
   const CameraIntrinsics camera = ScaledCamera(*context.camera, focal_scale);
   const Eigen::Isometry3d cam_from_world = CamFromWorld(Full(pose, context));
+  const Eigen::Isometry3d frustum_from_world = FrustumFromWorld(pose, context);
   std::vector<EdgeImage> out(context.edges->size());
   for (const auto& [e, l] : pairs) {
     EdgeImage& image = out.at(static_cast<size_t>(e));
     if (image.visible) continue;  // an edge paired twice
-    ClippedImage((*context.edges)[e], cam_from_world, camera, cam_from_world, camera, &image);
+    ClippedImage((*context.edges)[e], cam_from_world, camera, frustum_from_world, camera, &image);
   }
   return out;
 }

@@ -14,8 +14,13 @@
 
 namespace linetrack {
 
-// The full robot pose (known height and tilt) of a 3-DOF pose.
+// The full robot pose (known height and tilt) of a 3-DOF pose, without the context's roll: the
+// camera the de-rolled lines are matched in.
 RobotPose Full(const Pose3Dof& pose, const VerificationContext& context);
+
+// cam_from_world of the real camera at a 3-DOF pose, with the context's roll: its frustum bounds
+// what the image shows.
+Eigen::Isometry3d FrustumFromWorld(const Pose3Dof& pose, const VerificationContext& context);
 
 // The camera with its focal lengths scaled by `scale` (the estimated calibration error).
 CameraIntrinsics ScaledCamera(const CameraIntrinsics& camera, double scale);

@@ -42,10 +42,12 @@ void CheckProblem(const LocalizationProblem& p) {
   finite(p.delta_phi, "delta_phi");
   finite(p.height, "height");
   finite(p.tilt, "tilt");
+  finite(p.roll, "roll");
   if (p.delta_t < 0.0) throw InputError("delta_t: must be >= 0 metres");
   if (p.delta_phi <= 0.0 || p.delta_phi > kPi)
     throw InputError("delta_phi: must be in (0, 180] degrees");
   if (std::abs(p.tilt) >= 0.5 * kPi - 1e-6) throw InputError("tilt: must be in (-90, 90) degrees");
+  if (std::abs(p.roll) > kPi) throw InputError("roll: must be in [-180, 180] degrees");
   if (p.lines.empty()) throw InputError("lines: no line segments");
   for (size_t i = 0; i < p.lines.size(); ++i) {
     const Segment2& s = p.lines[i];
@@ -94,9 +96,22 @@ VisibilityQuery VisibilityQueryOf(const LocalizationProblem& problem,
   query.radius = problem.delta_t;
   query.heading = problem.prior.heading;
   query.heading_margin = problem.delta_phi;
-  query.bearing_half_width = BearingHalfWidth(camera, problem.tilt, problem.tilt);
+  query.bearing_half_width = BearingHalfWidth(camera, problem.tilt, problem.tilt, problem.roll);
   query.camera_z = problem.height;
   return query;
+}
+
+std::vector<Segment2> UnrolledLines(const std::vector<Segment2>& lines,
+                                    const CameraIntrinsics& camera, double roll) {
+  auto unroll = [&](const Eigen::Vector2d& pixel) {
+    const Eigen::Vector2d m = UnrollImagePoint(camera.Ray(pixel).head<2>(), roll);
+    return Eigen::Vector2d(camera.u0 + camera.px * m.x(), camera.v0 + camera.py * m.y());
+  };
+  std::vector<Segment2> out;
+  out.reserve(lines.size());
+  for (const Segment2& s : lines)
+    out.push_back({unroll(s.a), unroll(s.b)});
+  return out;
 }
 
 namespace {
@@ -443,11 +458,15 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     return result;
   }
   const std::vector<MatchEdge> edges = PrepareEdges(model_, ids);
+  // A rolled camera's lines are matched as the unrolled camera sees them; only the frustum of
+  // what the image shows stays the rolled camera's (VerificationContext::roll).
   const std::vector<ObservedLine> lines = PrepareLines(
-      problem.lines, camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
+      problem.roll == 0.0 ? problem.lines : UnrolledLines(problem.lines, camera_, problem.roll),
+      camera_, problem.tilt, options_.noise, options_.tree.vertical_gate_sigmas);
   const PriorRegion prior = Prior(problem);
-  const VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
-                                    &occlusion_, &prior, area_,    options_.noise};
+  VerificationContext context{&edges,      &lines, &camera_, problem.height, problem.tilt,
+                              &occlusion_, &prior, area_,    options_.noise};
+  context.roll = problem.roll;
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
     verified = SearchTree(context, options_, &result);
@@ -456,6 +475,10 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
     result.hypotheses = static_cast<int>(verified.size());
   }
   Decide(std::move(verified), context, options_.verification, &result);
+  if (result.found && problem.roll != 0.0) {
+    result.pose.roll = problem.roll;
+    result.cam_from_world = CamFromWorld(result.pose);
+  }
   return result;
 }
 

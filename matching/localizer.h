@@ -61,6 +61,9 @@ struct LocalizationProblem {
   double delta_phi = 0.0;  // prior heading bound (radians)
   double height = 0.0;     // camera height: world z of the optical centre (metres)
   double tilt = 0.0;       // camera tilt (radians, positive down)
+  // Known roll of the camera about its optical axis (radians, RobotPose's; a mount's): the lines
+  // are matched in the image of the unrolled camera (UnrolledLines) and the pose found has it.
+  double roll = 0.0;
   // When set, these model edge ids are the candidates instead of the view-invariant regions'
   // answer (e.g. a tracker that knows which edges it sees).
   std::optional<std::vector<int>> candidate_edges;
@@ -150,6 +153,12 @@ class Localizer {
 
 // Throws InputError naming the field when the problem is malformed.
 void CheckProblem(const LocalizationProblem& problem);
+
+// Undistorted segments (pixels) of a camera rolled by `roll` about its optical axis as the same
+// camera without the roll would see them: each end's normalised coordinates turned by
+// UnrollImagePoint (models/robot_pose.h), back to pixels with the same intrinsics.
+std::vector<Segment2> UnrolledLines(const std::vector<Segment2>& lines,
+                                    const CameraIntrinsics& camera, double roll);
 
 // The view-invariant regions' question for a problem's prior: its disk and heading interval, the
 // image's bearing half-width at its tilt, the camera's height (world z, which picks the storey).

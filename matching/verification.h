@@ -105,6 +105,10 @@ struct VerificationContext {
   LineNoise noise;  // line noise and calibration error (focal_relative)
   // When set, a pair (edge index, line index) guided matching may not use (a rival without it).
   std::pair<int, int> excluded_pair = {-1, -1};
+  // The camera's known roll about its optical axis (radians, RobotPose's): the lines are those
+  // the unrolled camera sees (UnrolledLines, localizer.h) and poses are projected without the
+  // roll; only the frustum of what the image shows is the rolled camera's.
+  double roll = 0.0;
 };
 
 // The work of the verification, for the localizer's deterministic budget: the (line, visible

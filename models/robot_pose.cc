@@ -18,9 +18,20 @@ Eigen::Matrix3d CamFromWorldRotation(double heading, double tilt) {
   return r;
 }
 
+Eigen::Matrix3d CamFromWorldRotation(double heading, double tilt, double roll) {
+  const Eigen::Matrix3d level = CamFromWorldRotation(heading, tilt);
+  if (roll == 0.0) return level;
+  const double c = std::cos(roll), s = std::sin(roll);
+  Eigen::Matrix3d r;
+  r.row(0) = c * level.row(0) + s * level.row(1);
+  r.row(1) = -s * level.row(0) + c * level.row(1);
+  r.row(2) = level.row(2);
+  return r;
+}
+
 Eigen::Isometry3d CamFromWorld(const RobotPose& pose) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = CamFromWorldRotation(pose.heading, pose.tilt);
+  t.linear() = CamFromWorldRotation(pose.heading, pose.tilt, pose.roll);
   t.translation() = -t.linear() * pose.Centre();
   return t;
 }
@@ -34,13 +45,21 @@ RobotPose RobotPoseFromCamFromWorld(const Eigen::Isometry3d& cam_from_world) {
   pose.x = centre.x();
   pose.y = centre.y();
   pose.height = centre.z();
-  pose.heading = std::atan2(right.x(), -right.y());
+  // The heading of f itself: for a camera without roll it equals atan2(r_x, -r_y).
+  pose.heading = std::atan2(forward.y(), forward.x());
   pose.tilt = std::asin(std::clamp(-forward.z(), -1.0, 1.0));
+  const Eigen::Matrix3d level = CamFromWorldRotation(pose.heading, pose.tilt);
+  pose.roll = std::atan2(right.dot(level.row(1)), right.dot(level.row(0)));
   return pose;
 }
 
 double RollOf(const Eigen::Isometry3d& cam_from_world) {
-  return std::asin(std::clamp(cam_from_world.linear()(0, 2), -1.0, 1.0));
+  return RobotPoseFromCamFromWorld(cam_from_world).roll;
+}
+
+Eigen::Vector2d UnrollImagePoint(const Eigen::Vector2d& normalised, double roll) {
+  const double c = std::cos(roll), s = std::sin(roll);
+  return {c * normalised.x() - s * normalised.y(), s * normalised.x() + c * normalised.y()};
 }
 
 Eigen::Matrix3d LevelFromCam(double tilt) {

@@ -132,7 +132,9 @@ class ViewInvariantRegions {
 // `camera` at any tilt in [tilt_min, tilt_max] (radians, within +-pi/2); pi when the image may
 // contain the nadir or zenith. In the level frame a ray m has bearing offset atan2(mL_x, mL_z).
 // The image is the pixel rectangle [0, width - 1] x [0, height - 1] (distorted when the camera
-// has distortion). Throws InputError when the camera or the tilt interval is invalid.
-double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max);
+// has distortion), of a camera rolled by `roll` about its optical axis (RobotPose's roll).
+// Throws InputError when the camera, the tilt interval or the roll is invalid.
+double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max,
+                        double roll = 0.0);
 
 }  // namespace linetrack

@@ -167,7 +167,8 @@ std::string ViewInvariantRegions::ExplainEmptyQuery(const VisibilityQuery& query
          Fixed(RadToDeg(query.heading_margin + query.bearing_half_width), 1) + " deg";
 }
 
-double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max) {
+double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max,
+                        double roll) {
   std::string why;
   if (!camera.Check(&why)) throw InputError("camera " + camera.name + ": " + why);
   if (camera.width <= 0 || camera.height <= 0) {
@@ -177,26 +178,33 @@ double BearingHalfWidth(const CameraIntrinsics& camera, double tilt_min, double 
         tilt_min >= -0.5 * kPi && tilt_max <= 0.5 * kPi)) {
     throw InputError("tilt interval: need -90 <= tilt_min <= tilt_max <= 90 degrees");
   }
-  // Box of the normalised coordinates (x, y) of the image's rays.
+  if (!std::isfinite(roll)) throw InputError("roll: not a finite number");
+  // Box of the normalised coordinates (x, y) of the image's rays, de-rolled (UnrollImagePoint).
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  auto add = [&](const Eigen::Vector2d& m) {
+    const Eigen::Vector2d unrolled = roll == 0.0 ? m : UnrollImagePoint(m, roll);
+    lo = lo.cwiseMin(unrolled);
+    hi = hi.cwiseMax(unrolled);
+  };
   const Eigen::Vector2d far_corner(camera.width - 1.0, camera.height - 1.0);
-  Eigen::Vector2d lo = camera.Ray(Eigen::Vector2d::Zero()).head<2>();
-  Eigen::Vector2d hi = camera.Ray(far_corner).head<2>();
-  if (camera.has_distortion) {
+  const Eigen::Vector2d m_lo = camera.Ray(Eigen::Vector2d::Zero()).head<2>();
+  const Eigen::Vector2d m_hi = camera.Ray(far_corner).head<2>();
+  if (!camera.has_distortion) {
+    add(m_lo), add(m_hi), add({m_lo.x(), m_hi.y()}), add({m_hi.x(), m_lo.y()});
+  } else {
     // The undistorted image of the border, sampled every pixel, grown by half a pixel.
-    lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    hi = -lo;
-    auto add = [&](double u, double v) {
+    const Eigen::Vector2d half_pixel(0.5 / camera.px, 0.5 / camera.py);
+    auto add_pixel = [&](double u, double v) {
       const Eigen::Vector2d m = camera.Ray(camera.Undistort({u, v})).head<2>();
-      lo = lo.cwiseMin(m);
-      hi = hi.cwiseMax(m);
+      for (double sx : {-1.0, 1.0})
+        for (double sy : {-1.0, 1.0})
+          add(m + Eigen::Vector2d(sx * half_pixel.x(), sy * half_pixel.y()));
     };
     for (int u = 0; u < camera.width; ++u)
-      add(u, 0.0), add(u, far_corner.y());
+      add_pixel(u, 0.0), add_pixel(u, far_corner.y());
     for (int v = 0; v < camera.height; ++v)
-      add(0.0, v), add(far_corner.x(), v);
-    const Eigen::Vector2d half_pixel(0.5 / camera.px, 0.5 / camera.py);
-    lo -= half_pixel;
-    hi += half_pixel;
+      add_pixel(0.0, v), add_pixel(far_corner.x(), v);
   }
   // |w| = atan2(|m_x|, mL_z) with mL_z = cos t - sin t m_y grows with |m_x| and is monotone in
   // m_y and, where mL_z > 0, in t over an interval: the extreme is at a corner of the box and an

@@ -50,7 +50,7 @@ struct LocalizeOptions {
 };
 
 // The integrity of the matcher's answer on its image: the moving edges and their sub-pixel points
-// at the answer (known height and tilt).
+// at the answer (known height, tilt and roll).
 PoseUncertainty CheckAnswer(const LocalizeOptions& opt, const ImageLines& image,
                             const LocalizationProblem& problem, const LocalizationResult& result,
                             const IntegrityOptions& options) {
@@ -61,9 +61,9 @@ PoseUncertainty CheckAnswer(const LocalizeOptions& opt, const ImageLines& image,
   }
   EdgeTracker tracker(opt.model_path, camera, TrackerSettings());
   ImageUndistorter undistorter(camera);
-  return UncertaintyOf(CheckPoseOnImage(&tracker, undistorter.Apply(image.image),
-                                        result.cam_from_world,
-                                        KnownHeightTilt{problem.height, problem.tilt}, options));
+  return UncertaintyOf(
+      CheckPoseOnImage(&tracker, undistorter.Apply(image.image), result.cam_from_world,
+                       KnownHeightTilt{problem.height, problem.tilt, problem.roll}, options));
 }
 
 // An answer whose protection levels exceed the alert limit is no answer: "ambiguous" when the

@@ -60,8 +60,8 @@ RobotPose CameraPrior(const Pose3Dof& map_base, const CameraMount& mount) {
   const Eigen::Vector2d centre =
       Eigen::Vector2d(map_base.x, map_base.y) +
       Eigen::Rotation2Dd(map_base.heading) * Eigen::Vector2d(mount.x, mount.y);
-  return RobotPose{centre.x(), centre.y(), WrapAngle(map_base.heading + mount.pan), mount.height,
-                   mount.tilt};
+  return RobotPose{centre.x(),   centre.y(), WrapAngle(map_base.heading + mount.pan),
+                   mount.height, mount.tilt, mount.roll};
 }
 
 Eigen::Isometry3d MapFromBase(const Eigen::Isometry3d& cam_from_map, const CameraMount& mount) {

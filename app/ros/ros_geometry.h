@@ -49,8 +49,8 @@ Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose);
 Pose3Dof PlanarOf(const Eigen::Isometry3d& pose);
 
 // The camera's reading for the tracker from the base's planar pose in the map and the mount:
-// position of the optical centre (base + Rz(yaw) (x, y)), heading = base yaw + pan, height and
-// tilt of the mount (the tracker's camera has no roll).
+// position of the optical centre (base + Rz(yaw) (x, y)), heading = base yaw + pan, height, tilt
+// and roll of the mount.
 RobotPose CameraPrior(const Pose3Dof& map_base, const CameraMount& mount);
 
 // map_from_base of a tracked camera: (cam_from_map)^-1 base_from_cam^-1.

@@ -87,6 +87,7 @@ TrackedFrame RosTracker::Process(const vpImage<unsigned char>& image, const Trac
   RobotReading reading;
   reading.height = input.mount.height;
   reading.tilt = input.mount.tilt;
+  reading.roll = input.mount.roll;
   if (input.odom_base && unanchored_start_) {  // the robot still where the initial pose put it
     map_from_odom_ =
         PlanarIsometry(*unanchored_start_) * PlanarIsometry(*input.odom_base).inverse();

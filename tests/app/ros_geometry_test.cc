@@ -49,6 +49,16 @@ TEST(RosGeometry, AnOffsetCameraSeesWhatTheRobotPoseSays) {
   EXPECT_NEAR(prior.y, 3.0 + n * 0.2 - c * 0.05, kExact);
 }
 
+// A camera rolled on its mount: the tracker's prior carries the roll and is the camera.
+TEST(RosGeometry, ARolledCamerasPriorIsTheCamera) {
+  Scene s;
+  s.mount.roll = DegToRad(-2.0);
+  s.cam_from_map = (s.map_from_base * BaseFromCamera(s.mount)).inverse();
+  const RobotPose prior = CameraPrior(s.base, s.mount);
+  EXPECT_NEAR(prior.roll, s.mount.roll, kExact);
+  EXPECT_TRUE(s.cam_from_map.isApprox(CamFromWorld(prior), kExact));
+}
+
 // TF gives base_from_cam: its mount (pan, tilt, roll, offsets) composes back to it exactly, and a
 // positive roll turns the image's x axis towards the image's y (down).
 TEST(RosGeometry, TheMountOfATransformComposesBackToIt) {

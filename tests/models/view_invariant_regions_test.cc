@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "models/cao_reader.h"
@@ -32,9 +33,10 @@ CameraIntrinsics MakeCamera(double focal, double u0 = 320.0, double v0 = 240.0) 
   return camera;
 }
 
-// Largest |atan2(mL_x, mL_z)| over the image border (every pixel) and tilts every 0.1 degree;
-// pi when a ray has mL_z <= 0.
-double BruteForceHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max) {
+// Largest |atan2(mL_x, mL_z)| over the image border (every pixel) of a camera rolled by `roll`
+// and tilts every 0.1 degree; pi when a ray has mL_z <= 0.
+double BruteForceHalfWidth(const CameraIntrinsics& camera, double tilt_min, double tilt_max,
+                           double roll = 0.0) {
   std::vector<Eigen::Vector2d> border;
   for (int u = 0; u < camera.width; ++u)
     border.push_back({u, 0.0}), border.push_back({u, camera.height - 1.0});
@@ -45,7 +47,8 @@ double BruteForceHalfWidth(const CameraIntrinsics& camera, double tilt_min, doub
   for (int k = 0; k <= steps; ++k) {
     const Eigen::Matrix3d level = LevelFromCam(tilt_min + (tilt_max - tilt_min) * k / steps);
     for (const Eigen::Vector2d& uv : border) {
-      const Eigen::Vector3d m = level * camera.Ray(camera.Undistort(uv));
+      const Eigen::Vector2d rolled = camera.Ray(camera.Undistort(uv)).head<2>();
+      const Eigen::Vector3d m = level * UnrollImagePoint(rolled, roll).homogeneous();
       if (m.z() <= 0.0) return kPi;
       widest = std::max(widest, std::abs(std::atan2(m.x(), m.z())));
     }
@@ -78,6 +81,26 @@ TEST(BearingHalfWidth, MatchesBruteForceOverTheImageBorder) {
   }
   // The paper's camera, level: the left column u = 0 is 320 px from the centre.
   EXPECT_NEAR(BearingHalfWidth(MakeCamera(1000.0), 0.0, 0.0), std::atan(0.32), kAngleTolRad);
+}
+
+TEST(BearingHalfWidth, BoundsARolledCameraOverTheImageBorder) {
+  const struct {
+    CameraIntrinsics camera;
+    double tilt_deg, roll_deg, tolerance;
+  } cases[] = {
+      {MakeCamera(1000.0), 0.0, 5.0, 0.01},    // the box of the turned border: a bound
+      {MakeCamera(1000.0), 20.0, -5.0, 0.01},  //
+      {MakeCamera(300.0), 10.0, 1.5, 0.01},    //
+      {MakeCamera(500.0, 60.0, 450.0), 15.0, 180.0, kAngleTolRad},  // upside down: exact
+  };
+  for (const auto& c : cases) {
+    const double tilt = DegToRad(c.tilt_deg), roll = DegToRad(c.roll_deg);
+    const double computed = BearingHalfWidth(c.camera, tilt, tilt, roll);
+    const double brute = BruteForceHalfWidth(c.camera, tilt, tilt, roll);
+    EXPECT_GE(computed, brute - kAngleTolRad) << "roll " << c.roll_deg;
+    EXPECT_LE(computed, brute + c.tolerance) << "roll " << c.roll_deg;
+  }
+  EXPECT_THROW(BearingHalfWidth(MakeCamera(500.0), 0.0, 0.1, std::nan("")), InputError);
 }
 
 TEST(BearingHalfWidth, IsPiWhenTheNadirCanBeInTheImage) {

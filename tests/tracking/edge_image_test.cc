@@ -139,6 +139,47 @@ TEST(EdgeRefinement, BringsAPerturbedPoseBackOnTheEdges) {
   EXPECT_LT(ComparePoses(robot.cam_from_world, truth).translation, kRefinedPositionTolM);
 }
 
+// A camera rolled 1.5 degrees about its optical axis (its mount's roll): with the known height,
+// tilt and roll the refinement of (x, y, heading) comes back on the truth and keeps the roll;
+// believing the camera level it cannot.
+TEST(EdgeRefinement, KeepsAKnownRollAndConvergesToTheTruth) {
+  HallView hall;
+  hall.pose.roll = DegToRad(1.5);
+  const vpImage<unsigned char> image = hall.Render(false);
+  const Eigen::Isometry3d truth = CamFromWorld(hall.pose);
+  std::vector<Segment3> edges;
+  for (const ModelEdge& e : hall.model.edges())
+    edges.push_back(e.segment);
+  RobotPose off = hall.pose;
+  off.x += 0.012;
+  off.y -= 0.01;
+  off.heading += DegToRad(0.1);
+  const Eigen::Isometry3d start = CamFromWorld(off);
+  const std::vector<Eigen::Vector2d> sites = IntegerSites(hall, truth);
+  const CameraIntrinsics camera = hall.camera.Undistorted();
+  const EdgeRefinement rolled =
+      RefineOnEdges(image, camera, edges, sites,
+                    {start, KnownHeightTilt{hall.pose.height, hall.pose.tilt, hall.pose.roll}}, {});
+  ASSERT_TRUE(rolled.applied) << rolled.refusal;
+  const RobotPose refined = RobotPoseFromCamFromWorld(rolled.cam_from_world);
+  EXPECT_NEAR(refined.height, hall.pose.height, 1e-9);
+  EXPECT_NEAR(refined.tilt, hall.pose.tilt, 1e-9);
+  EXPECT_NEAR(refined.roll, hall.pose.roll, 1e-9);
+  const PoseDifference error = ComparePoses(rolled.cam_from_world, truth);
+  EXPECT_LT(error.translation, kRefinedPositionTolM);
+  EXPECT_LT(RadToDeg(error.rotation), kRefinedRotationTolDeg);
+  std::printf("rolled camera: refined %.4f m, %.4f deg from the truth\n", error.translation,
+              RadToDeg(error.rotation));
+  // Control: the same start believed level is refused (the roll moves the image corners by
+  // several pixels) or fits worse.
+  const EdgeRefinement level = RefineOnEdges(
+      image, camera, edges, sites, {start, KnownHeightTilt{hall.pose.height, hall.pose.tilt}}, {});
+  std::printf("believed level: %s, rms %.3f px (rolled: %.3f px)\n",
+              level.applied ? "applied" : level.refusal.c_str(), level.rms_after_px,
+              rolled.rms_after_px);
+  EXPECT_TRUE(!level.applied || level.rms_after_px > 2.0 * rolled.rms_after_px);
+}
+
 TEST(EdgeRefinement, AlignsAPredictionSeveralPixelsOff) {
   const HallView hall;
   const vpImage<unsigned char> image = hall.Render(false);

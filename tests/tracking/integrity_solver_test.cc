@@ -118,27 +118,33 @@ TEST(IntegrityResidual, CasingOffsetsAreTheEndResidualsOfAShiftedEdge) {
 
 // The robot's unknowns and its height and tilt map to world twists as TwistOf... say.
 TEST(IntegrityResidual, RobotParametersMapToWorldTwists) {
-  const RobotPose robot = TestRobotPose();
-  const Eigen::Isometry3d pose = CamFromWorld(robot);
-  const PoseParameterisation parameters(KnownHeightTilt{robot.height, robot.tilt});
-  const Eigen::MatrixXd unknowns = parameters.TwistOfUnknowns();
-  for (int j = 0; j < 3; ++j) {
-    Eigen::VectorXd delta = Eigen::VectorXd::Zero(3);
-    delta[j] = kJacobianStep;
-    const WorldTwist numeric =
-        WorldTwistBetween(pose, parameters.Apply(pose, delta)) / kJacobianStep;
-    EXPECT_LT((numeric - unknowns.col(j)).norm(), 1e-5) << "unknown " << j;
+  for (double roll_deg : {0.0, 2.0}) {  // a camera held level, and one rolled on its mount
+    RobotPose robot = TestRobotPose();
+    robot.roll = DegToRad(roll_deg);
+    const Eigen::Isometry3d pose = CamFromWorld(robot);
+    const PoseParameterisation parameters(KnownHeightTilt{robot.height, robot.tilt, robot.roll});
+    const Eigen::MatrixXd unknowns = parameters.TwistOfUnknowns();
+    for (int j = 0; j < 3; ++j) {
+      Eigen::VectorXd delta = Eigen::VectorXd::Zero(3);
+      delta[j] = kJacobianStep;
+      const Eigen::Isometry3d moved = parameters.Apply(pose, delta);
+      const WorldTwist numeric = WorldTwistBetween(pose, moved) / kJacobianStep;
+      EXPECT_LT((numeric - unknowns.col(j)).norm(), 1e-5) << "unknown " << j;
+      EXPECT_NEAR(RollOf(moved), robot.roll, 1e-12);  // the known roll is kept
+    }
+    const Eigen::MatrixXd robot_map = parameters.TwistOfRobotParameters(pose);
+    RobotPose higher = robot, tilted = robot, rolled = robot;
+    higher.height += kJacobianStep;
+    tilted.tilt += kJacobianStep;
+    rolled.roll += kJacobianStep;
+    int k = 0;
+    for (const RobotPose& changed : {higher, tilted, rolled}) {
+      const WorldTwist numeric = WorldTwistBetween(pose, CamFromWorld(changed)) / kJacobianStep;
+      EXPECT_LT((numeric - robot_map.col(k)).norm(), 1e-5)
+          << "parameter " << k << " roll " << roll_deg;
+      ++k;
+    }
   }
-  const Eigen::MatrixXd robot_map = parameters.TwistOfRobotParameters(pose);
-  RobotPose higher = robot, tilted = robot;
-  higher.height += kJacobianStep;
-  tilted.tilt += kJacobianStep;
-  EXPECT_LT(
-      (WorldTwistBetween(pose, CamFromWorld(higher)) / kJacobianStep - robot_map.col(0)).norm(),
-      1e-5);
-  EXPECT_LT(
-      (WorldTwistBetween(pose, CamFromWorld(tilted)) / kJacobianStep - robot_map.col(1)).norm(),
-      1e-5);
 }
 
 TEST(IntegrityResidual, WorldTwistRoundTrip) {

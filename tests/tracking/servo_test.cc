@@ -108,13 +108,34 @@ TEST(HeadPointing, AnyMountGivesTheHeadingAndTiltOfItsOpticalAxis) {
     const RobotPose pose = CameraPoseOnHead(geometry, base, crossing, pan, tilt);
     const Eigen::Isometry3d cam_from_world =
         CamFromWorldOnHead(geometry, base, crossing, pan, tilt);
-    // The optical axis of the pose agrees with the camera's; the centre is the camera's.
+    // The optical axis of the pose agrees with the camera's; the centre is the camera's; with
+    // its roll the pose is the camera.
     const Eigen::Vector3d axis = cam_from_world.linear().row(2).transpose();
     EXPECT_LT((CamFromWorld(pose).linear().row(2).transpose() - axis).norm(), kPoseTol);
     EXPECT_LT((CamFromWorld(pose).inverse().translation() - cam_from_world.inverse().translation())
                   .norm(),
               kPoseTol);
+    EXPECT_TRUE(CamFromWorld(pose).isApprox(cam_from_world, kPoseTol));
   }
+}
+
+TEST(HeadPointing, AMountRolledAboutTheOpticalAxisGivesThatRoll) {
+  const Pose3Dof base{1.0, -2.0, DegToRad(40.0)};
+  for (double roll_deg : {0.87, -2.0}) {
+    HeadGeometry geometry = GeometryOf(HeadModel::kPtu46);
+    geometry.tilt_from_camera.rotate(
+        Eigen::AngleAxisd(DegToRad(roll_deg), Eigen::Vector3d::UnitZ()));
+    const double crossing = CrossingHeightFor(geometry, 1.3);
+    for (double tilt_deg : {0.0, 15.0, -10.0}) {
+      const RobotPose pose = CameraPoseOnHead(geometry, base, crossing, 0.3, DegToRad(tilt_deg));
+      EXPECT_NEAR(pose.roll, DegToRad(roll_deg), kPoseTol);
+      EXPECT_NEAR(pose.tilt, DegToRad(tilt_deg), kPoseTol);
+    }
+  }
+  // The upside-down camera is rolled half a turn.
+  const HeadGeometry biclops = GeometryOf(HeadModel::kBiclops);
+  const RobotPose upside_down = CameraPoseOnHead(biclops, base, 1.2, 0.0, DegToRad(10.0));
+  EXPECT_NEAR(std::abs(upside_down.roll), kPi, kPoseTol);
 }
 
 TEST(HeadServo, SaturationKeepsTheDirection) {

@@ -139,6 +139,13 @@ TEST(Health, RobotConstraintAndMotion) {
   Eigen::Isometry3d rolled = CamFromWorld(RobotPose{2, 3, 1.0, 1.3, DegToRad(5.0)});
   rolled.prerotate(Eigen::AngleAxisd(DegToRad(8.0), Eigen::Vector3d::UnitZ()));  // about the axis
   EXPECT_NE(ConstraintProblem(rolled, c).find("roll"), std::string::npos);
+  // A known roll (the camera's mount): that roll passes, none or another does not.
+  c.roll = DegToRad(8.0);
+  EXPECT_EQ(ConstraintProblem(CamFromWorld(RobotPose{2, 3, 1.0, 1.3, DegToRad(5.0), c.roll}), c),
+            "");
+  EXPECT_NE(ConstraintProblem(CamFromWorld(RobotPose{2, 3, 1.0, 1.3, DegToRad(5.0)}), c), "");
+  EXPECT_NE(ConstraintProblem(CamFromWorld(RobotPose{2, 3, 1.0, 1.3, DegToRad(5.0), -c.roll}), c),
+            "");
 
   const MotionLimits limits;  // 5 m/s, 360 deg/s
   const Eigen::Isometry3d a = CamFromWorld(RobotPose{0, 0, 0, 1.3, 0});

@@ -77,12 +77,7 @@ Eigen::Isometry3d CamFromWorldOnHead(const HeadGeometry& geometry, const Pose3Do
 
 RobotPose CameraPoseOnHead(const HeadGeometry& geometry, const Pose3Dof& base,
                            double crossing_height, double pan, double tilt) {
-  const Eigen::Isometry3d world_from_camera =
-      WorldFromHeadBase(geometry, base, crossing_height) * BaseFromCamera(geometry, pan, tilt);
-  const Eigen::Vector3d centre = world_from_camera.translation();
-  const Eigen::Vector3d axis = world_from_camera.linear().col(2);
-  return {centre.x(), centre.y(), std::atan2(axis.y(), axis.x()), centre.z(),
-          std::asin(std::clamp(-axis.z(), -1.0, 1.0))};
+  return RobotPoseFromCamFromWorld(CamFromWorldOnHead(geometry, base, crossing_height, pan, tilt));
 }
 
 bool HeadAnglesLookingAt(const HeadGeometry& geometry, const Eigen::Isometry3d& world_from_base,

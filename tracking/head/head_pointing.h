@@ -27,10 +27,11 @@ double CrossingHeightFor(const HeadGeometry& geometry, double camera_height);
 Eigen::Isometry3d CamFromWorldOnHead(const HeadGeometry& geometry, const Pose3Dof& base,
                                      double crossing_height, double pan, double tilt);
 
-// The camera's pose in the matcher's terms: its centre (x, y, height) on the head, and the heading
-// and tilt of its optical axis f (atan2(f_y, f_x), asin(-f_z)); for a camera aligned with the
-// tilt frame on a level base these are base heading + pan and the head's tilt (the paper's "tilt
-// known but variable" case). The matcher's model has no roll: a mount's roll is left out.
+// The camera's pose in the matcher's terms: its centre (x, y, height) on the head, the heading
+// and tilt of its optical axis f (atan2(f_y, f_x), asin(-f_z)) and its roll about f
+// (RobotPoseFromCamFromWorld of CamFromWorldOnHead); for a camera aligned with the tilt frame on
+// a level base these are base heading + pan, the head's tilt (the paper's "tilt known but
+// variable" case) and no roll.
 RobotPose CameraPoseOnHead(const HeadGeometry& geometry, const Pose3Dof& base,
                            double crossing_height, double pan, double tilt);
 

@@ -80,7 +80,7 @@ Eigen::Isometry3d PoseParameterisation::Apply(const Eigen::Isometry3d& pose,
   if (!known_) return ApplyWorldTwist(pose, delta);
   const RobotPose robot = RobotPoseFromCamFromWorld(pose);
   return CamFromWorld(RobotPose{robot.x + delta[0], robot.y + delta[1], robot.heading + delta[2],
-                                known_->height, known_->tilt});
+                                known_->height, known_->tilt, known_->roll});
 }
 
 Eigen::VectorXd PoseParameterisation::Difference(const Eigen::Isometry3d& estimate,
@@ -102,7 +102,10 @@ Eigen::MatrixXd PoseParameterisation::TwistOfUnknowns() const {
 
 Eigen::MatrixXd PoseParameterisation::TwistOfRobotParameters(const Eigen::Isometry3d& pose) const {
   if (!known_) return Eigen::MatrixXd::Zero(6, 0);
-  const Eigen::Matrix3d rotation = pose.linear();
+  // R_wc = CamFromWorldRotation(h, t)^T Rz(roll): the tilt turns it about the unrolled camera's
+  // (horizontal) x axis r, the roll about f.
+  const RobotPose robot = RobotPoseFromCamFromWorld(pose);
+  const Eigen::Matrix3d rotation = CamFromWorldRotation(robot.heading, robot.tilt);
   Eigen::MatrixXd map = Eigen::MatrixXd::Zero(6, 3);
   map(2, 0) = 1.0;                                       // height
   map.block<3, 1>(3, 1) = -rotation.row(0).transpose();  // tilt: about -r

@@ -61,7 +61,7 @@ Eigen::Isometry3d ApplyWorldTwist(const Eigen::Isometry3d& cam_from_world, const
 // ApplyWorldTwist (rotation angle below pi).
 WorldTwist WorldTwistBetween(const Eigen::Isometry3d& reference, const Eigen::Isometry3d& pose);
 
-// The unknowns of the pose. A robot (known height and tilt, zero roll): x = (x, y, heading),
+// The unknowns of the pose. A robot (known height, tilt and roll): x = (x, y, heading),
 // metres and radians, heading as in method.md. A free camera: x = (C, omega) in the world frame,
 // 6 unknowns. `considered` are what the solve holds fixed but is uncertain: (s, u0, v0) and, for
 // a robot, (height, tilt, roll).
@@ -75,8 +75,8 @@ class PoseParameterisation {
   int dof() const { return robot() ? 3 : 6; }
   int considered() const { return robot() ? 6 : 3; }
 
-  // The pose moved by `delta` (dof() values). A robot's result has the known height and tilt and
-  // zero roll whatever `pose` has.
+  // The pose moved by `delta` (dof() values). A robot's result has the known height, tilt and
+  // roll whatever `pose` has.
   Eigen::Isometry3d Apply(const Eigen::Isometry3d& pose, const Eigen::VectorXd& delta) const;
 
   // The unknowns' difference estimate - truth (heading wrapped; rotation as a world vector).
@@ -87,7 +87,8 @@ class PoseParameterisation {
   Eigen::MatrixXd TwistOfUnknowns() const;
 
   // A robot's d (dC, omega) / d (height, tilt, roll) at `pose` (6 x 3): height -> dC_z, tilt ->
-  // omega = -r (camera x axis), roll -> omega = f (optical axis); a free camera's is 6 x 0.
+  // omega = -r (the unrolled camera's x axis, horizontal), roll -> omega = f (optical axis); a
+  // free camera's is 6 x 0.
   Eigen::MatrixXd TwistOfRobotParameters(const Eigen::Isometry3d& pose) const;
 
  private:

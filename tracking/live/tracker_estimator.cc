@@ -21,6 +21,7 @@ RobotReading RobotReadingOf(const RobotPose& camera_prior) {
   reading.odometry = camera_prior.Planar();
   reading.height = camera_prior.height;
   reading.tilt = camera_prior.tilt;
+  reading.roll = camera_prior.roll;
   return reading;
 }
 

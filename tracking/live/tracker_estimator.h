@@ -22,7 +22,7 @@ namespace linetrack {
 PoseStatus PoseStatusOf(TrackStatus status);
 
 // The robot's reading for the tracker from the loop's camera prior: odometry (x, y, heading),
-// height and tilt.
+// height, tilt and roll.
 RobotReading RobotReadingOf(const RobotPose& camera_prior);
 
 // What the tracker is made of: the tracking engine's options.

@@ -83,7 +83,7 @@ double Rms(const Eigen::VectorXd& r) {
 }
 
 // The pose as a function of the unknowns: 6 (a left-multiplied twist on the start pose) or, with
-// a known height and tilt, 3 (x, y, heading of the robot pose; roll zero).
+// a known height, tilt and roll, 3 (x, y, heading of the robot pose).
 class PoseParameters {
  public:
   PoseParameters(const Eigen::Isometry3d& start, const std::optional<KnownHeightTilt>& known)
@@ -97,7 +97,7 @@ class PoseParameters {
   Eigen::Isometry3d Pose(const Eigen::VectorXd& p) const {
     if (!known_) return Update(start_, p);
     return CamFromWorld(RobotPose{base_.x() + p[0], base_.y() + p[1], base_.z() + p[2],
-                                  known_->height, known_->tilt});
+                                  known_->height, known_->tilt, known_->roll});
   }
 
  private:

@@ -43,11 +43,12 @@ struct EdgeRefinementOptions {
 double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vector2d& point,
                           const Eigen::Vector2d& normal, double search_px, double min_gradient);
 
-// A robot camera's known height (metres) and tilt (radians): with it the refinement estimates
-// x, y and heading only, with zero roll (docs/conventions.md).
+// A robot camera's known height (metres), tilt and roll about the optical axis (radians,
+// RobotPose's): with it the refinement estimates x, y and heading only (docs/conventions.md).
 struct KnownHeightTilt {
   double height = 0.0;
   double tilt = 0.0;
+  double roll = 0.0;  // the mount's, zero for a camera held level
 };
 
 // One model edge and the sub-pixel edge points the refinement attached to it: the measurements
@@ -82,8 +83,8 @@ struct EdgeRefinement {
   std::vector<EdgeObservation> set_aside;
 };
 
-// Where a refinement starts: a pose and, for a robot, its known height and tilt (the result then
-// keeps them, with zero roll).
+// Where a refinement starts: a pose and, for a robot, its known height, tilt and roll (the result
+// then keeps them).
 struct RefinementStart {
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();
   std::optional<KnownHeightTilt> known;

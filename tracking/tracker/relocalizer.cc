@@ -55,6 +55,7 @@ RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
   prior.heading = WrapAngle(last_good.heading + (odometry_now.heading - odometry_then.heading));
   prior.height = odometry_now.height;
   prior.tilt = odometry_now.tilt;
+  prior.roll = odometry_now.roll;
   return prior;
 }
 
@@ -88,6 +89,7 @@ RelocalizationAttempt Relocalizer::Attempt(const vpImage<unsigned char>& undisto
   problem.delta_phi = bounds.delta_phi;
   problem.height = prior.height;
   problem.tilt = prior.tilt;
+  problem.roll = prior.roll;
   start = std::chrono::steady_clock::now();
   const LocalizationResult result = localizer_.Localize(problem);
   attempt.match_ms = MillisecondsSince(start);

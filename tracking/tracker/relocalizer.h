@@ -42,7 +42,7 @@ SearchBounds WidenedBounds(int frames_since_good, const RelocalizationOptions& o
 
 // The robot's prior now, carried from the last good pose by the odometry since then: the planar
 // motion odometry_now (-) odometry_then expressed in the odometry's frame at `then`, applied to
-// `last_good` (SE(2) composition); height and tilt are the current readings.
+// `last_good` (SE(2) composition); height, tilt and roll are the current readings.
 RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
                      const RobotPose& odometry_now);
 
@@ -63,8 +63,8 @@ class Relocalizer {
   Relocalizer(const Localizer& localizer, LineExtractorFunction extractor,
               const RelocalizationOptions& options = {});
 
-  // Extracts lines from `undistorted` and runs the matcher around `prior` (its height and tilt
-  // are taken as known) within `bounds`.
+  // Extracts lines from `undistorted` and runs the matcher around `prior` (its height, tilt and
+  // roll are taken as known) within `bounds`.
   RelocalizationAttempt Attempt(const vpImage<unsigned char>& undistorted, const RobotPose& prior,
                                 const SearchBounds& bounds) const;
 

@@ -30,6 +30,7 @@ std::optional<RobotPose> InterpolatePrior(const std::vector<PriorRecord>& record
   p.heading = WrapAngle(a.pose.heading + s * WrapAngle(b.pose.heading - a.pose.heading));
   p.height = a.pose.height + s * (b.pose.height - a.pose.height);
   p.tilt = a.pose.tilt + s * (b.pose.tilt - a.pose.tilt);
+  p.roll = a.pose.roll + s * WrapAngle(b.pose.roll - a.pose.roll);
   return p;
 }
 

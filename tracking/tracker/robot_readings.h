@@ -11,8 +11,8 @@
 namespace linetrack {
 
 // The prior at time t (seconds): linear interpolation of x, y, height and tilt between the two
-// records around t, the heading along the shorter way; outside the records' time range the first
-// or last record when within max_gap seconds, else nullopt.
+// records around t, the heading and roll along the shorter way; outside the records' time range the
+// first or last record when within max_gap seconds, else nullopt.
 std::optional<RobotPose> InterpolatePrior(const std::vector<PriorRecord>& records, double t,
                                           double max_gap);
 

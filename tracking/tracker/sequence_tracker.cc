@@ -17,11 +17,11 @@ using Clock = std::chrono::steady_clock;
 
 std::optional<KnownHeightTilt> Known(const std::optional<RobotReading>& robot) {
   if (!robot) return std::nullopt;
-  return KnownHeightTilt{robot->height, robot->tilt};
+  return KnownHeightTilt{robot->height, robot->tilt, robot->roll};
 }
 
 RobotPose WithReading(const Pose3Dof& planar, const RobotReading& robot) {
-  return RobotPose{planar.x, planar.y, planar.heading, robot.height, robot.tilt};
+  return RobotPose{planar.x, planar.y, planar.heading, robot.height, robot.tilt, robot.roll};
 }
 
 Pose3Dof PlanarOf(const Eigen::Isometry3d& cam_from_world) {
@@ -79,6 +79,7 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
   RobotConstraint tolerances = robot_tolerances;
   tolerances.height = 0.0;
   tolerances.tilt = 0.0;
+  tolerances.roll = 0.0;
   if (!health.Check(why) || !motion.Check(why) || !tolerances.Check(why)) return false;
   if (!integrity.Check(why) || !reacquisition.Check(why)) return false;
   if (restart_window < 0) {
@@ -126,7 +127,9 @@ std::string SequenceTracker::Judge(const EdgeTrackResult& result, double t,
     RobotConstraint constraint = options_.robot_tolerances;
     constraint.height = robot->height;
     constraint.tilt = robot->tilt;
-    // ViSP's own pose (6 unknowns) drifting from the robot's height and tilt betrays a bad track.
+    constraint.roll = robot->roll;
+    // ViSP's own pose (6 unknowns) drifting from the robot's height, tilt and roll betrays a bad
+    // track.
     problem = ConstraintProblem(result.visp_cam_from_world, constraint);
   }
   if (problem.empty() &&

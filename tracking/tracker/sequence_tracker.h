@@ -38,6 +38,7 @@ struct RobotReading {
   std::optional<Pose3Dof> odometry;
   double height = 0.0;  // metres
   double tilt = 0.0;    // radians, positive down
+  double roll = 0.0;    // radians about the optical axis (RobotPose's; a mount's)
 };
 
 // A pose found by the matcher (the first one or after a loss) is reported degraded until it is
@@ -66,7 +67,7 @@ struct SequenceTrackerOptions {
   ReacquisitionCheck reacquisition;
   HealthThresholds health;
   MotionLimits motion;
-  RobotConstraint robot_tolerances;  // its height and tilt are replaced by each frame's reading
+  RobotConstraint robot_tolerances;  // its height, tilt and roll are each frame's reading
   // After a loss, also try restarting the tracker from the last good pose (the only recovery of
   // a free camera; for a robot, tried after the matcher).
   bool restart_from_last_good = true;
@@ -97,8 +98,8 @@ struct SequenceTrackerOptions {
 };
 
 // The camera pose now from the last pose and the robot's readings then and now (odometry position
-// and heading, height, tilt): C_now C_then^-1 last, with C = CamFromWorld of a reading. Keeps the
-// last pose's own roll and small errors; only the relative motion of the odometry is used.
+// and heading, height, tilt, roll): C_now C_then^-1 last, with C = CamFromWorld of a reading.
+// Keeps the last pose's own small errors; only the relative motion of the odometry is used.
 Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const RobotPose& then,
                                       const RobotPose& now);
 

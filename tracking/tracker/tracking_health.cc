@@ -35,8 +35,8 @@ bool HealthThresholds::Check(std::string* why) const {
 }
 
 bool RobotConstraint::Check(std::string* why) const {
-  if (!std::isfinite(height) || !(std::abs(tilt) < M_PI / 2)) {
-    *why = "robot height must be finite and tilt within (-90, 90) degrees";
+  if (!std::isfinite(height) || !(std::abs(tilt) < M_PI / 2) || !std::isfinite(roll)) {
+    *why = "robot height and roll must be finite and tilt within (-90, 90) degrees";
     return false;
   }
   if (!(height_tolerance > 0.0) || !(tilt_tolerance > 0.0) || !(roll_tolerance > 0.0)) {
@@ -97,9 +97,9 @@ std::string ConstraintProblem(const Eigen::Isometry3d& cam_from_world,
     return Format("tilt %.1f deg, the robot says %.1f", RadToDeg(pose.tilt),
                   RadToDeg(constraint.tilt));
   }
-  const double roll = RollOf(cam_from_world);
-  if (!(std::abs(roll) <= constraint.roll_tolerance)) {
-    return Format("roll %.1f deg, limit %.1f", RadToDeg(roll), RadToDeg(constraint.roll_tolerance));
+  if (!(std::abs(WrapAngle(pose.roll - constraint.roll)) <= constraint.roll_tolerance)) {
+    return Format("roll %.1f deg, the robot says %.1f", RadToDeg(pose.roll),
+                  RadToDeg(constraint.roll));
   }
   return {};
 }

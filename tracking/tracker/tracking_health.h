@@ -50,11 +50,12 @@ struct HealthThresholds {
   bool Check(std::string* why) const;
 };
 
-// The camera height and tilt a robot knows (odometry, head encoders), with the tolerances a
-// tracked pose must respect; roll must stay near zero.
+// The camera height, tilt and roll a robot knows (odometry, head encoders, the camera's mount),
+// with the tolerances a tracked pose must respect.
 struct RobotConstraint {
   double height = 0.0;  // metres
   double tilt = 0.0;    // radians, positive looking down
+  double roll = 0.0;    // radians about the optical axis (RobotPose's)
   double height_tolerance = 0.15;
   double tilt_tolerance = 0.0873;  // 5 degrees
   double roll_tolerance = 0.0873;
@@ -85,7 +86,7 @@ PoseDifference ComparePoses(const Eigen::Isometry3d& cam_from_world_a,
 // Empty when `health` passes every threshold, else why not ("projection error 41.2 deg > 30").
 std::string HealthProblem(const TrackHealth& health, const HealthThresholds& thresholds);
 
-// Empty when the pose respects the robot's height, tilt and zero roll, else why not.
+// Empty when the pose respects the robot's height, tilt and roll, else why not.
 std::string ConstraintProblem(const Eigen::Isometry3d& cam_from_world,
                               const RobotConstraint& constraint);
 
