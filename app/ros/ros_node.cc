@@ -233,8 +233,9 @@ void RosNode::Impl::OnInitialPose(const geometry_msgs::PoseWithCovarianceStamped
 
 bool RosNode::Impl::OnGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   ROS_ERROR(
-      "linetrack: global localisation is not available yet: give the pose on initialpose "
-      "(RViz's 2D Pose Estimate)");
+      "linetrack: global localisation is not offered by the node: the global mode still "
+      "accepts wrong poses (docs/global.md); give the pose on initialpose (RViz's 2D Pose "
+      "Estimate)");
   return false;
 }
 
