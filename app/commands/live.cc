@@ -145,8 +145,8 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
   plan.use_tracker = opt.estimator != "truth";
   if (plan.use_tracker && plan.head_model == HeadModel::kBiclops) {
     throw InputError(
-        "--head-model biclops: its camera is upside down and the tracker's robot checks assume "
-        "an upright camera (roll 0); use --estimator truth with the simulator");
+        "--head-model biclops: its camera is upside down (roll 180 deg), which the tracker has "
+        "not been tested with; use --estimator truth with the simulator");
   }
   CheckRange(opt.camera_fps, 0.0, 1000.0, "--camera-fps");
   plan.camera_fps = opt.camera_fps;
