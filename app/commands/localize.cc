@@ -90,7 +90,7 @@ void WithholdAnswer(const LocalizationResult& result, const PoseUncertainty& u,
 }
 
 // Why a global answer from line segments alone is no answer: the global mode's verification can
-// accept a wrong pose where the building repeats itself (docs/global.md), and only the image's
+// accept a wrong pose when its searches miss the truth (docs/global.md), and only the image's
 // integrity check (--image) can tell.
 constexpr const char* kUnverifiedGlobal =
     "a global answer from line segments alone is not verified: give the image (--image) so "
