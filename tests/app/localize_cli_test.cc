@@ -3,8 +3,8 @@
 // unreadable batch exits 2 with one line, and the single-case form prints the batch's JSON keys,
 // takes replay's prior bounds by default, names the matched edges, reads a ROS camera_info as
 // its camera and refuses bad heights and flags that cannot apply. The global mode (no prior): a
-// batch case with "prior": null and the --global flags find a case's true pose, and --global with
-// a prior is refused.
+// batch case with "prior": null and the --global flags give a case's true pose as an unverified
+// candidate, and --global with a prior is refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,6 +22,12 @@ namespace {
 const std::string kSource = LINETRACK_SOURCE_DIR;
 
 class LocalizeCli : public test_support::CliTest {};
+
+// Writes a case's "lines" ([[u1, v1, u2, v2], ...]) as CSV rows, one segment each.
+void WriteSegmentRows(const nlohmann::json& lines, std::ostream& csv) {
+  for (const auto& l : lines)
+    csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+}
 using test_support::CommandRun;
 
 TEST_F(LocalizeCli, MalformedCasesGetAnErrorAndTheOthersAreAnswered) {
@@ -128,8 +134,7 @@ TEST_F(LocalizeCli, SingleCasePrintsTheBatchKeysOrFailsCleanly) {
   const nlohmann::json c = nlohmann::json::parse(row);
   std::ofstream csv(dir_ / "lines.csv");
   csv << "u1,v1,u2,v2\n";
-  for (const auto& l : c["lines"])
-    csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+  WriteSegmentRows(c["lines"], csv);
   csv.close();
   std::ostringstream args;
   args << "localize --model " << kSource << "/models/hall.cao --camera " << synth
@@ -178,8 +183,7 @@ class LocalizeSingleCli : public LocalizeCli {
     std::getline(cases, row);
     sc.json = nlohmann::json::parse(row);
     std::ofstream csv(dir / "lines.csv");
-    for (const auto& l : sc.json["lines"])
-      csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+    WriteSegmentRows(sc.json["lines"], csv);
     std::ostringstream flags;
     flags << "--model " << kSource << "/models/hall.cao --lines " << (dir / "lines.csv").string()
           << " --prior " << sc.json["prior"][0] << "," << sc.json["prior"][1] << ","
@@ -395,8 +399,7 @@ TEST_F(LocalizeGlobalCli, BatchCaseWithANullPriorGivesTheTruthAsACandidate) {
 TEST_F(LocalizeGlobalCli, GlobalFlagGivesTheTruthAsACandidateAndRefusesAPrior) {
   const GlobalCase gc = MakeGlobalCase();
   std::ofstream csv(dir_ / "lines.csv");
-  for (const auto& l : gc.json["lines"])
-    csv << l[0] << "," << l[1] << "," << l[2] << "," << l[3] << "\n";
+  WriteSegmentRows(gc.json["lines"], csv);
   csv.close();
   std::ostringstream flags;
   flags << "localize --global --model " << kSource << "/models/hall.cao --camera " << gc.synth
