@@ -6,6 +6,14 @@ function(linetrack_strict_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
 endfunction()
 
+# Precompiled headers: the third-party headers that most of the project's files include (Eigen in
+# nine files of ten, ViSP's pose and image types in four of ten, GoogleTest in every test), parsed
+# once per build instead of once per file. One header is compiled for the libraries (the first
+# library built, linetrack_models, hosts it) and one for the tests (linetrack_test_pch).
+set(LINETRACK_PCH_HEADERS <algorithm> <cmath> <functional> <map> <memory> <optional> <sstream>
+    <string> <vector> <Eigen/Core> <Eigen/Geometry> <visp3/core/vpHomogeneousMatrix.h>
+    <visp3/core/vpImage.h>)
+
 # linetrack_add_library(NAME linetrack_models SRCS a.cc b.cc PUBLIC_LINK ... PRIVATE_LINK ...)
 function(linetrack_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_LINK;PRIVATE_LINK" ${ARGN})
@@ -14,6 +22,34 @@ function(linetrack_add_library)
   target_link_libraries(${ARG_NAME} PUBLIC ${ARG_PUBLIC_LINK} PRIVATE ${ARG_PRIVATE_LINK})
   set_target_properties(${ARG_NAME} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   linetrack_strict_warnings(${ARG_NAME})
+  if(LINETRACK_PRECOMPILE_HEADERS)
+    if(ARG_NAME STREQUAL "linetrack_models")
+      target_precompile_headers(${ARG_NAME} PRIVATE ${LINETRACK_PCH_HEADERS})
+    else()
+      target_precompile_headers(${ARG_NAME} REUSE_FROM linetrack_models)
+    endif()
+  endif()
+endfunction()
+
+# The tests' compile definitions (every test binary has the same; see linetrack_add_test).
+function(linetrack_test_definitions target)
+  target_compile_definitions(${target} PRIVATE
+    LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
+    LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")
+endfunction()
+
+# The tests' precompiled header, built by an object library with a test binary's flags.
+function(linetrack_add_test_pch)
+  if(NOT LINETRACK_PRECOMPILE_HEADERS)
+    return()
+  endif()
+  file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/test_pch.cc "// hosts the tests' precompiled header\n")
+  add_library(linetrack_test_pch OBJECT ${CMAKE_CURRENT_BINARY_DIR}/test_pch.cc)
+  target_link_libraries(linetrack_test_pch PRIVATE GTest::gtest Eigen3::Eigen ${VISP_LIBRARIES})
+  target_include_directories(linetrack_test_pch PRIVATE ${LINETRACK_SOURCE_DIR} ${VISP_INCLUDE_DIRS})
+  linetrack_test_definitions(linetrack_test_pch)
+  linetrack_strict_warnings(linetrack_test_pch)
+  target_precompile_headers(linetrack_test_pch PRIVATE <gtest/gtest.h> ${LINETRACK_PCH_HEADERS})
 endfunction()
 
 # linetrack_add_test(NAME models_cao_reader SRCS cao_reader_test.cc LINK linetrack_models)
@@ -27,10 +63,11 @@ function(linetrack_add_test)
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
   target_include_directories(${ARG_NAME} PRIVATE ${LINETRACK_SOURCE_DIR})  # tests/support/
-  target_compile_definitions(${ARG_NAME} PRIVATE
-    LINETRACK_SOURCE_DIR="${LINETRACK_SOURCE_DIR}"
-    LINETRACK_BINARY_DIR="${CMAKE_BINARY_DIR}")
+  linetrack_test_definitions(${ARG_NAME})
   linetrack_strict_warnings(${ARG_NAME})
+  if(LINETRACK_PRECOMPILE_HEADERS)
+    target_precompile_headers(${ARG_NAME} REUSE_FROM linetrack_test_pch)
+  endif()
   set(properties ${ARG_PROPERTIES})
   if(LINETRACK_SANITIZE)  # leaks inside third-party libraries only; see the file
     list(APPEND properties ENVIRONMENT
