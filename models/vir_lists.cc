@@ -122,11 +122,10 @@ struct SmallRing {
   size_t n = 0;
 };
 
-// The part of the convex ring where n.p >= offset - slack (Sutherland-Hodgman); false when the
-// part would exceed the capacity (then `out` is not set).
-bool ClipToHalfPlane(const SmallRing& ring, const Eigen::Vector2d& n, double offset, double slack,
+// The part of the convex ring where n.p >= offset - slack (Sutherland-Hodgman): at most one
+// vertex more than the ring, which must leave room for it.
+void ClipToHalfPlane(const SmallRing& ring, const Eigen::Vector2d& n, double offset, double slack,
                      SmallRing* out) {
-  if (ring.n + 1 > SmallRing::kCapacity) return false;
   out->n = 0;
   for (size_t i = 0; i < ring.n; ++i) {
     const Eigen::Vector2d &p = ring.p[i], &q = ring.p[(i + 1) % ring.n];
@@ -134,7 +133,6 @@ bool ClipToHalfPlane(const SmallRing& ring, const Eigen::Vector2d& n, double off
     if (vp >= 0.0) out->p[out->n++] = p;
     if ((vp >= 0.0) != (vq >= 0.0)) out->p[out->n++] = p + vp / (vp - vq) * (q - p);
   }
-  return true;
 }
 
 // The box of a float box holding [lo, hi].
@@ -207,7 +205,8 @@ bool SegmentNearConvex(const Ring2& hull, const Segment2& s, double tolerance) {
 bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, const Line2& line,
                double slack, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
   SmallRing part, clipped;
-  if (ring.size() + 2 * footprint.size() + 1 >= SmallRing::kCapacity) {
+  // Each of the 1 + 2 |footprint| clips adds at most a vertex.
+  if (ring.size() + 2 * footprint.size() + 1 > SmallRing::kCapacity) {
     part.n = 0;  // too many vertices to clip here: the whole ring
   } else {
     part.n = ring.size();
