@@ -26,6 +26,9 @@ constexpr double kPlanTolerance = 1e-6;
 // loop of occluders with at most this many sides is a solid.
 constexpr double kEventRange = 15.0;
 constexpr int kMaxSolidSides = 16;
+// A cell split into at least this many regions keeps its edges' occluders: gathering them costs
+// about as much as a few walks along each sight line.
+constexpr int kRegionsToKeepOccluders = 4;
 
 // The floor-plan footprint of an edge: one point for a vertical edge, else its two end points.
 Ring2 Footprint(const ModelEdge& edge) {
@@ -269,10 +272,16 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   occluders.solid_sides = SegmentGrid(std::move(sides));
   occluders.seen.assign(occluders.solids.size(), 0);
   occluders_.insert(occluders_.end(), walls.begin(), walls.end());
-  // The initial cells' lists first; a region split from one tests only its cell's list.
+  // The initial cells' lists first; a region split from one tests only its cell's list. A cell
+  // split into many regions keeps each edge's occluders for them.
+  std::vector<int> regions_of(initial.size(), 0);
+  for (const Cell& cell : cells)
+    ++regions_of[cell.parent];
   std::vector<CellList> cell_lists(initial.size());
   ForEach(initial.size(), options.threads, occluders, [&](size_t i, const StoreyOccluders& own) {
-    cell_lists[i] = CellVisibility(initial[i].ring, model, edges, own, options.hidden_margin);
+    const CellOccluders keep =
+        regions_of[i] >= kRegionsToKeepOccluders ? CellOccluders::kKeep : CellOccluders::kNone;
+    cell_lists[i] = CellVisibility(initial[i].ring, model, edges, own, options.hidden_margin, keep);
   });
   const size_t first = regions_.size();
   regions_.resize(first + cells.size());
@@ -281,7 +290,7 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
     region.polygon.vertices = cells[i].ring;
     region.storey = s;
     region.visible = options.direct_lists
-                         ? DirectVisibility(cells[i].ring, model, edges, own, options.hidden_margin)
+                         ? DirectVisibility(cells[i], model, edges, own, options.hidden_margin)
                          : RegionVisibility(cells[i], model, edges, cell_lists[cells[i].parent],
                                             own, options.hidden_margin);
   });

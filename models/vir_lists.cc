@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "models/plan_visibility.h"
 
@@ -94,6 +95,23 @@ bool BehindItsFaces(const ModelEdge& edge, const Ring2& region, const WireframeM
   });
 }
 
+// False when no part of the cell (cameras between z_lo and z_hi) can lie behind every face of the
+// edge, all one-sided: a vertical face has no vertex of the cell behind it by `margin` (less a
+// rounding allowance), or a horizontal face is not behind the band.
+bool MaybeBehindItsFaces(const ModelEdge& edge, const Ring2& cell, const WireframeModel& model,
+                         const StoreyEdges& edges, double margin) {
+  constexpr double kRounding = 1e-9;  // metres
+  const std::vector<int>& faces = (*edges.one_sided_faces)[edge.id];
+  return !faces.empty() && std::all_of(faces.begin(), faces.end(), [&](int f) {
+    const ModelFace& face = model.faces()[f];
+    if (!face.vertical) return Behind(face, cell, edges.z_lo, edges.z_hi, margin);
+    const Eigen::Vector2d n = face.normal.head<2>();
+    return std::any_of(cell.begin(), cell.end(), [&](const Eigen::Vector2d& p) {
+      return n.dot(p) - face.offset < -margin + kRounding;
+    });
+  });
+}
+
 // Counter-clockwise convex hull of the points (Andrew's monotone chain).
 Ring2 Hull(Ring2 points) {
   std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -144,12 +162,49 @@ CellOccluder Occluder(int id, const Eigen::Vector2d& lo, const Eigen::Vector2d& 
           std::nextafter(static_cast<float>(hi.y()), inf)};
 }
 
+// A counter-clockwise convex ring and its edges' outward unit normals (none for a zero edge).
+struct HullAxes {
+  Ring2 hull;
+  std::vector<std::pair<Eigen::Vector2d, double>> normals;  // n and n.(a vertex of its edge)
+};
+
+HullAxes AxesOf(Ring2 hull) {
+  HullAxes axes{std::move(hull), {}};
+  const Ring2& h = axes.hull;
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Eigen::Vector2d e = h[(i + 1) % h.size()] - h[i];
+    const double length = e.norm();
+    if (length == 0.0) continue;
+    const Eigen::Vector2d n = Eigen::Vector2d(e.y(), -e.x()) / length;
+    axes.normals.emplace_back(n, n.dot(h[i]));
+  }
+  return axes;
+}
+
+// SegmentNearConvex with the ring's axes computed once.
+bool SegmentNearHull(const HullAxes& axes, const Segment2& s, double tolerance) {
+  for (const auto& [n, offset] : axes.normals) {
+    if (std::min(n.dot(s.a), n.dot(s.b)) - offset > tolerance) return false;
+  }
+  const Eigen::Vector2d d = s.b - s.a;
+  const double length = d.norm();
+  if (length == 0.0) return true;
+  const Eigen::Vector2d m = Eigen::Vector2d(d.y(), -d.x()) / length;
+  double lo = m.dot(axes.hull.front() - s.a), hi = lo;
+  for (const Eigen::Vector2d& p : axes.hull) {
+    lo = std::min(lo, m.dot(p - s.a));
+    hi = std::max(hi, m.dot(p - s.a));
+  }
+  return lo <= tolerance && hi >= -tolerance;
+}
+
 // The occluders of `footprint` for the cell `ring` (CellList), appended to `out`.
 void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const StoreyOccluders& o,
                           double margin, std::vector<CellOccluder>* out) {
   Ring2 points = ring;
   points.insert(points.end(), footprint.begin(), footprint.end());
-  const Ring2 hull = Hull(std::move(points));
+  const HullAxes axes = AxesOf(Hull(std::move(points)));
+  const Ring2& hull = axes.hull;
   Eigen::Vector2d lo = ring.front(), hi = lo;
   for (const Eigen::Vector2d& p : ring)
     lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -163,7 +218,7 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
       f_hi = std::max(f_hi, line.SignedDistance(f));
     }
     if (f_hi > -margin && f_lo < margin) return;
-    if (!SegmentNearConvex(hull, wall, kHullTolerance)) return;
+    if (!SegmentNearHull(axes, wall, kHullTolerance)) return;
     Eigen::Vector2d s_lo, s_hi;
     if (ShadowBox(ring, footprint, wall, line, kHullTolerance, &s_lo, &s_hi))
       out->push_back(Occluder(i, s_lo, s_hi));
@@ -172,7 +227,7 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
   o.solid_sides.InConvex(hull, kHullTolerance, [&](int side) {
     const int solid = o.solid_of_side[side];
     if (o.seen[solid] == o.test) return;
-    if (!SegmentNearConvex(hull, o.solid_sides.segments()[side], kHullTolerance)) return;
+    if (!SegmentNearHull(axes, o.solid_sides.segments()[side], kHullTolerance)) return;
     o.seen[solid] = o.test;
     out->push_back(Occluder(-1 - solid, lo, hi));
   });
@@ -180,26 +235,8 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
 
 }  // namespace
 
-bool SegmentNearConvex(const Ring2& hull, const Segment2& s, double tolerance) {
-  // The ring's edges' outward normals.
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
-    const double length = e.norm();
-    if (length == 0.0) continue;
-    const Eigen::Vector2d n = Eigen::Vector2d(e.y(), -e.x()) / length;
-    if (std::min(n.dot(s.a - hull[i]), n.dot(s.b - hull[i])) > tolerance) return false;
-  }
-  // The segment's normal.
-  const Eigen::Vector2d d = s.b - s.a;
-  const double length = d.norm();
-  if (length == 0.0) return true;
-  const Eigen::Vector2d m = Eigen::Vector2d(d.y(), -d.x()) / length;
-  double lo = m.dot(hull.front() - s.a), hi = lo;
-  for (const Eigen::Vector2d& p : hull) {
-    lo = std::min(lo, m.dot(p - s.a));
-    hi = std::max(hi, m.dot(p - s.a));
-  }
-  return lo <= tolerance && hi >= -tolerance;
+bool SegmentNearConvex(const Ring2& ring, const Segment2& s, double tolerance) {
+  return SegmentNearHull(AxesOf(ring), s, tolerance);
 }
 
 bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, const Line2& line,
@@ -236,9 +273,9 @@ bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, 
 }
 
 CellList CellVisibility(const Ring2& ring, const WireframeModel& model, const StoreyEdges& edges,
-                        const StoreyOccluders& occluders, double margin) {
+                        const StoreyOccluders& occluders, double margin, CellOccluders keep) {
   CellList list;
-  list.first.push_back(0);
+  if (keep == CellOccluders::kKeep) list.first.push_back(0);
   const Eigen::Vector2d centre = RingCentroid(ring);
   for (size_t k = 0; k < edges.ids.size(); ++k) {
     const ModelEdge& edge = model.edges()[edges.ids[k]];
@@ -246,28 +283,25 @@ CellList CellVisibility(const Ring2& ring, const WireframeModel& model, const St
     const Ring2& footprint = edges.footprints[k];
     if (edges.in_band[k]) {
       if (Hidden(ring, centre, footprint, occluders, margin)) continue;
-      OccludersOfFootprint(ring, footprint, occluders, margin, &list.occluders);
+      if (keep == CellOccluders::kKeep)
+        OccludersOfFootprint(ring, footprint, occluders, margin, &list.occluders);
     }
     list.edges.push_back(static_cast<int>(k));
-    list.first.push_back(static_cast<int>(list.occluders.size()));
+    if (keep == CellOccluders::kKeep) {
+      list.first.push_back(static_cast<int>(list.occluders.size()));
+      list.maybe_behind.push_back(MaybeBehindItsFaces(edge, ring, model, edges, margin) ? 1 : 0);
+    }
   }
   return list;
 }
 
-std::vector<RegionEdge> DirectVisibility(const Ring2& region, const WireframeModel& model,
+std::vector<RegionEdge> DirectVisibility(const Cell& region, const WireframeModel& model,
                                          const StoreyEdges& edges, const StoreyOccluders& occluders,
                                          double margin) {
-  std::vector<RegionEdge> visible;
-  const Eigen::Vector2d centroid = RingCentroid(region);
-  for (size_t k = 0; k < edges.ids.size(); ++k) {
-    const ModelEdge& edge = model.edges()[edges.ids[k]];
-    if (BehindItsFaces(edge, region, model, edges, margin)) continue;
-    const Ring2& footprint = edges.footprints[k];
-    if (edges.in_band[k] && Hidden(region, centroid, footprint, occluders, margin)) continue;
-    const BearingRange range = BearingsToFootprint(region, footprint, centroid);
-    visible.push_back({edge.id, range.min, range.max, range.all});
-  }
-  return visible;
+  CellList all;
+  all.edges.resize(edges.ids.size());
+  std::iota(all.edges.begin(), all.edges.end(), 0);
+  return RegionVisibility(region, model, edges, all, occluders, margin);
 }
 
 std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeModel& model,
@@ -277,10 +311,12 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
   visible.reserve(cell.edges.size());
   const Ring2& ring = region.ring;
   const Eigen::Vector2d centroid = RingCentroid(ring);
+  const bool walk = cell.first.empty();
   for (size_t j = 0; j < cell.edges.size(); ++j) {
     const int k = cell.edges[j];
     const ModelEdge& edge = model.edges()[edges.ids[k]];
-    if (BehindItsFaces(edge, ring, model, edges, margin)) continue;
+    if ((walk || cell.maybe_behind[j]) && BehindItsFaces(edge, ring, model, edges, margin))
+      continue;
     const Ring2& footprint = edges.footprints[k];
     // An occluder hides the edge from the region only when it hides it from all its points: the
     // region lies in the occluder's box.
@@ -293,9 +329,13 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
                                       occluders.wall_lines[o.id], margin)
                        : HiddenBySolid(ring, footprint, occluders.solids[-1 - o.id], margin);
     };
-    const CellOccluder* begin = cell.occluders.data() + cell.first[j];
-    const CellOccluder* end = cell.occluders.data() + cell.first[j + 1];
-    if (edges.in_band[k] && std::any_of(begin, end, hides)) continue;
+    if (edges.in_band[k]) {
+      if (walk && Hidden(ring, centroid, footprint, occluders, margin)) continue;
+      if (!walk && std::any_of(cell.occluders.data() + cell.first[j],
+                               cell.occluders.data() + cell.first[j + 1], hides)) {
+        continue;
+      }
+    }
     const BearingRange range = BearingsToFootprint(ring, footprint, centroid);
     visible.push_back({edge.id, range.min, range.max, range.all});
   }

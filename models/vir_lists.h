@@ -51,28 +51,34 @@ struct CellOccluder {
 // (indices into StoreyEdges::ids, ascending) and, for edge j, occluders[first[j], first[j + 1]):
 // the walls with the footprint beyond their line by the hidden margin whose shadow meets the cell,
 // and the solids that meet the hull of the cell and the footprint.
+// With the occluders, per edge: whether a part of the cell may lie behind all its faces.
 struct CellList {
   std::vector<int> edges;
   std::vector<int> first;
   std::vector<CellOccluder> occluders;
+  std::vector<char> maybe_behind;
 };
+
+// Whether a cell's list keeps, per edge, the occluders that can hide it from a part of the cell:
+// worth it for a cell split into many regions; without them a region walks each sight line.
+enum class CellOccluders { kKeep, kNone };
 
 // The list of cell `ring` among all the storey's edges: an edge is out of sight behind its
 // one-sided faces, or when an occluder or a solid hides its whole footprint from the whole cell
 // by `margin` metres (one met by the sight line between their centres: docs/models.md).
 CellList CellVisibility(const Ring2& ring, const WireframeModel& model, const StoreyEdges& edges,
-                        const StoreyOccluders& occluders, double margin);
+                        const StoreyOccluders& occluders, double margin, CellOccluders keep);
 
 // The visibility list (with bearing ranges) of a region (a cell split from the cell of `cell`):
-// the same test as CellVisibility's, among the cell's edges and, per edge, its occluders.
+// the same test as CellVisibility's, among the cell's edges, against each edge's occluders when
+// the cell kept them, else by walking the sight line between the centres.
 std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeModel& model,
                                          const StoreyEdges& edges, const CellList& cell,
                                          const StoreyOccluders& occluders, double margin);
 
 // The visibility list of a region tested directly against every edge of the storey, walking the
-// sight line between their centres through the walls (CellVisibility's test, with bearing ranges):
-// the reference RegionVisibility must equal.
-std::vector<RegionEdge> DirectVisibility(const Ring2& region, const WireframeModel& model,
+// sight line between their centres through the walls: the reference RegionVisibility must equal.
+std::vector<RegionEdge> DirectVisibility(const Cell& region, const WireframeModel& model,
                                          const StoreyEdges& edges, const StoreyOccluders& occluders,
                                          double margin);
 
