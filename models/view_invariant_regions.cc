@@ -28,7 +28,7 @@ constexpr double kEventRange = 15.0;
 constexpr int kMaxSolidSides = 16;
 // A cell split into at least this many regions keeps its edges' occluders: gathering them costs
 // about as much as a few walks along each sight line.
-constexpr int kRegionsToKeepOccluders = 4;
+constexpr int kRegionsToKeepOccluders = 8;
 
 // The floor-plan footprint of an edge: one point for a vertical edge, else its two end points.
 Ring2 Footprint(const ModelEdge& edge) {

@@ -241,34 +241,39 @@ bool SegmentNearConvex(const Ring2& ring, const Segment2& s, double tolerance) {
 
 bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, const Line2& line,
                double slack, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
-  SmallRing part, clipped;
   // Each of the 1 + 2 |footprint| clips adds at most a vertex.
   if (ring.size() + 2 * footprint.size() + 1 > SmallRing::kCapacity) {
-    part.n = 0;  // too many vertices to clip here: the whole ring
-  } else {
-    part.n = ring.size();
-    std::copy(ring.begin(), ring.end(), part.p.begin());
-    // The far side of the line from the footprint.
-    const double side = line.SignedDistance(footprint.front()) < 0.0 ? 1.0 : -1.0;
-    ClipToHalfPlane(part, side * line.normal, side * line.offset, slack, &clipped);
-    part = clipped;
-    const Eigen::Vector2d d = line.Direction();
-    const Eigen::Vector2d a = wall.a - slack * d, b = wall.b + slack * d;
-    for (const Eigen::Vector2d& f : footprint) {
-      // The cone from f through a and b: on b's side of line f-a and on a's side of line f-b.
-      const double turn = Cross2(a - f, b - f) > 0.0 ? 1.0 : -1.0;
-      const Eigen::Vector2d ea = (a - f).normalized(), eb = (b - f).normalized();
-      const Eigen::Vector2d na = turn * Eigen::Vector2d(-ea.y(), ea.x());
-      const Eigen::Vector2d nb = -turn * Eigen::Vector2d(-eb.y(), eb.x());
-      ClipToHalfPlane(part, na, na.dot(f), slack, &clipped);
-      ClipToHalfPlane(clipped, nb, nb.dot(f), slack, &part);
-    }
-    if (part.n == 0) return false;
+    *lo = *hi = ring.front();  // too many vertices to clip here: the whole ring
+    for (const Eigen::Vector2d& p : ring)
+      *lo = lo->cwiseMin(p), *hi = hi->cwiseMax(p);
+    return true;
   }
-  const Ring2 whole = part.n == 0 ? ring : Ring2(part.p.begin(), part.p.begin() + part.n);
-  *lo = *hi = whole.front();
-  for (const Eigen::Vector2d& p : whole)
-    *lo = lo->cwiseMin(p), *hi = hi->cwiseMax(p);
+  SmallRing parts[2];
+  int now = 0;
+  parts[now].n = ring.size();
+  std::copy(ring.begin(), ring.end(), parts[now].p.begin());
+  const auto clip = [&](const Eigen::Vector2d& n, double offset) {
+    ClipToHalfPlane(parts[now], n, offset, slack, &parts[1 - now]);
+    now = 1 - now;
+    return parts[now].n > 0;
+  };
+  // The far side of the line from the footprint.
+  const double side = line.SignedDistance(footprint.front()) < 0.0 ? 1.0 : -1.0;
+  if (!clip(side * line.normal, side * line.offset)) return false;
+  const Eigen::Vector2d d = line.Direction();
+  const Eigen::Vector2d a = wall.a - slack * d, b = wall.b + slack * d;
+  for (const Eigen::Vector2d& f : footprint) {
+    // The cone from f through a and b: on b's side of line f-a and on a's side of line f-b.
+    const double turn = Cross2(a - f, b - f) > 0.0 ? 1.0 : -1.0;
+    const Eigen::Vector2d ea = (a - f).normalized(), eb = (b - f).normalized();
+    const Eigen::Vector2d na = turn * Eigen::Vector2d(-ea.y(), ea.x());
+    const Eigen::Vector2d nb = -turn * Eigen::Vector2d(-eb.y(), eb.x());
+    if (!clip(na, na.dot(f)) || !clip(nb, nb.dot(f))) return false;
+  }
+  const SmallRing& part = parts[now];
+  *lo = *hi = part.p[0];
+  for (size_t i = 0; i < part.n; ++i)
+    *lo = lo->cwiseMin(part.p[i]), *hi = hi->cwiseMax(part.p[i]);
   return true;
 }
 
