@@ -275,7 +275,8 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
                                  const Eigen::Vector2d& region_centroid) {
   BearingRange range;
   range.all = true;
-  if (MayTouch(region, footprint)) {
+  const bool may_touch = MayTouch(region, footprint);
+  if (may_touch) {
     if (footprint.size() == 1) {
       if (ConvexContains(region, footprint[0], kTouch)) return range;
     } else {
@@ -304,7 +305,7 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
   for (const Eigen::Vector2d& f : footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
-      if (v.norm() <= kTouch) return range;
+      if (may_touch && v.norm() <= kTouch) return range;
       const double key = PseudoAngle(centre.dot(v), Cross2(centre, v));
       if (key < lo_key) lo_key = key, lo_v = v;
       if (key > hi_key) hi_key = key, hi_v = v;
