@@ -25,6 +25,7 @@ bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vec
 // rounding of a hit point; cells are no smaller than kMinCell (metres).
 constexpr double kPlanMargin = 1e-6;
 constexpr double kMinCell = 0.25;
+constexpr size_t kFacesWithoutGrid = 64;
 
 }  // namespace
 
@@ -145,6 +146,8 @@ bool OcclusionTester::Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Ve
 
 bool OcclusionTester::Blocked(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                               double tolerance) const {
+  // A model of a few faces (one room) is quicker to test face by face than to walk.
+  if (faces_.size() <= kFacesWithoutGrid) return BlockedByAnyFace(eye, target, tolerance);
   if ((target - eye).norm() <= tolerance) return false;
   return AlongPlan(eye, target, [&](int i) { return Crosses(i, eye, target, tolerance); });
 }

@@ -1,18 +1,17 @@
 // The occlusion tester's plan grid: Blocked answers as testing every face in turn, on random
-// sight segments (long, short, vertical, and ending on model edges) in the bundled models.
+// sight segments (long, short, vertical, and ending on model edges) in generated buildings (a
+// bundled model has too few faces for the grid).
 #include "models/occlusion.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
-#include <string>
 
+#include "models/synth/synthetic_building.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
 namespace {
-
-const std::string kModels = std::string(LINETRACK_SOURCE_DIR) + "/models";
 
 // Segments over the model's box grown by 1 m in plan: every fourth short, every fourth ending on a
 // model edge, every sixteenth vertical. Returns how many are blocked; expects Blocked to agree
@@ -45,11 +44,14 @@ int ExpectGridEqualsEveryFace(const WireframeModel& model, int count) {
 }
 
 TEST(OcclusionTester, GridAnswersAsEveryFace) {
-  for (const char* name : {"hall.cao", "office.cao", "room.cao"}) {
-    SCOPED_TRACE(name);
+  for (int rooms_per_side : {2, 9}) {
+    SCOPED_TRACE(rooms_per_side);
+    BuildingSpec spec;
+    spec.rooms_per_side = rooms_per_side;
+    const WireframeModel model = WireframeModel::FromCao(GenerateBuilding(spec).cao);
+    ASSERT_GT(model.faces().size(), 100u);  // enough faces for the grid
     const int count = 20000;
-    const int blocked =
-        ExpectGridEqualsEveryFace(WireframeModel::Load(kModels + "/" + name), count);
+    const int blocked = ExpectGridEqualsEveryFace(model, count);
     EXPECT_GT(blocked, count / 10);  // the segments exercise both answers
     EXPECT_LT(blocked, count - count / 10);
   }
