@@ -18,6 +18,24 @@ const std::string kHall = kSource + "/models/hall.cao";
 class UsageCli : public test_support::CliTest {};
 using test_support::CommandRun;
 
+// The file's text, or "(none)" when it is not there; removes it.
+std::string TakeFile(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path)) return "(none)";
+  const std::string text = test_support::ReadAll(path);
+  std::filesystem::remove(path);
+  return text;
+}
+
+// `text` without its lines that report a time in milliseconds ("..._ms").
+std::string WithoutTimings(const std::string& text) {
+  std::istringstream lines(text);
+  std::string line, kept;
+  while (std::getline(lines, line)) {
+    if (line.find("_ms\"") == std::string::npos) kept += line + "\n";
+  }
+  return kept;
+}
+
 TEST_F(UsageCli, FlagsThatCannotApplyAreRefused) {
   const std::string out = (dir_ / "never").string();
   const std::vector<std::pair<std::string, std::string>> refused = {
@@ -112,6 +130,29 @@ TEST_F(UsageCli, ModelInfoListsEveryEdgeWithItsName) {
   const CommandRun text = Linetrack("model-info " + kHall + " --edges");
   ASSERT_EQ(text.code, 0) << text.err;
   EXPECT_NE(text.out.find("   0  door_south_jamb_a"), std::string::npos) << text.out;
+}
+
+// The CLI server (tests/support/cli_server.cc) runs the binary's own code: the same exit codes,
+// stdout (but its timings), stderr and files as the binary, quoted words included.
+TEST_F(UsageCli, TheCliServerRunsWhatTheBinaryRuns) {
+  const std::filesystem::path written = dir_ / "with space.cao";
+  const std::vector<std::string> commands = {
+      "--version",
+      "model-info " + kHall + " --json",
+      "model-info " + kSource + "/models/missing.cao",
+      "localize --lines nothing.csv --model " + kHall,
+      "make-building '" + written.string() + "'",
+      "no-such-command",
+  };
+  for (const std::string& args : commands) {
+    const CommandRun server = Linetrack(args);
+    const std::string server_file = TakeFile(written);
+    const CommandRun binary = LinetrackBinary(args);
+    EXPECT_EQ(server.code, binary.code) << args;
+    EXPECT_EQ(WithoutTimings(server.out), WithoutTimings(binary.out)) << args;
+    EXPECT_EQ(server.err, binary.err) << args;
+    EXPECT_EQ(server_file, TakeFile(written)) << args;
+  }
 }
 
 }  // namespace
