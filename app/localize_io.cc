@@ -112,8 +112,8 @@ nlohmann::ordered_json GlobalResultToJson(const nlohmann::json& id, const Global
   if (!result.found) {
     shown = LocalizationResult();
     shown.reason = result.reason;
-    for (const HeadingSearch& s : result.searches)
-      shown.hypotheses += s.result.hypotheses;
+    for (const PeakVerification& v : result.verifications)
+      shown.hypotheses += v.result.hypotheses;
   }
   nlohmann::ordered_json out = ResultToJson(id, shown, time_ms, model);
   out["global"] = true;
@@ -129,6 +129,7 @@ nlohmann::ordered_json GlobalResultToJson(const nlohmann::json& id, const Global
     headings.push_back(RadToDeg(WrapAngle(s.heading)));
   out["headings_deg"] = headings;
   out["searches"] = result.searches.size();
+  out["verified_peaks"] = result.verifications.size();
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace linetrack {
 namespace {
@@ -19,6 +20,12 @@ bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vec
   }
   return inside;
 }
+
+// Faces are listed in the grid cells their plan box, grown by this (metres), meets: far above the
+// rounding of a hit point; cells are no smaller than kMinCell (metres).
+constexpr double kPlanMargin = 1e-6;
+constexpr double kMinCell = 0.25;
+constexpr size_t kFacesWithoutGrid = 64;
 
 }  // namespace
 
@@ -40,27 +47,116 @@ OcclusionTester::OcclusionTester(const WireframeModel& model) {
     }
     faces_.push_back(std::move(face));
   }
+  BuildPlanGrid();
+}
+
+void OcclusionTester::BuildPlanGrid() {
+  if (faces_.empty()) {
+    cells_.assign(1, {});
+    return;
+  }
+  Eigen::Vector2d lo = faces_.front().box_min.head<2>(), hi = faces_.front().box_max.head<2>();
+  for (const Face& face : faces_)
+    lo = lo.cwiseMin(face.box_min.head<2>()), hi = hi.cwiseMax(face.box_max.head<2>());
+  lo -= Eigen::Vector2d::Constant(kPlanMargin);
+  hi += Eigen::Vector2d::Constant(kPlanMargin);
+  const Eigen::Vector2d extent = hi - lo;
+  cell_ = std::max(kMinCell, std::sqrt(extent.prod() / static_cast<double>(faces_.size())));
+  origin_ = lo;
+  cols_ = static_cast<int>(extent.x() / cell_) + 1;
+  rows_ = static_cast<int>(extent.y() / cell_) + 1;
+  cells_.assign(static_cast<size_t>(cols_) * rows_, {});
+  for (size_t i = 0; i < faces_.size(); ++i) {
+    const Eigen::Vector2d a = faces_[i].box_min.head<2>() - Eigen::Vector2d::Constant(kPlanMargin);
+    const Eigen::Vector2d b = faces_[i].box_max.head<2>() + Eigen::Vector2d::Constant(kPlanMargin);
+    const Eigen::Vector4i r(Col(a.x()), Col(b.x()), Row(a.y()), Row(b.y()));
+    for (int row = r[2]; row <= r[3]; ++row) {
+      for (int col = r[0]; col <= r[1]; ++col)
+        cells_[static_cast<size_t>(row) * cols_ + col].push_back(static_cast<int>(i));
+    }
+    rectangles_.push_back(r);
+  }
+}
+
+int OcclusionTester::Col(double x) const {
+  return std::clamp(static_cast<int>(std::floor((x - origin_.x()) / cell_)), 0, cols_ - 1);
+}
+
+int OcclusionTester::Row(double y) const {
+  return std::clamp(static_cast<int>(std::floor((y - origin_.y()) / cell_)), 0, rows_ - 1);
+}
+
+template <typename Test>
+bool OcclusionTester::AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                const Test& test) const {
+  // Cells of the plan segment a -> b (Amanatides-Woo); the segment is not clipped to the grid:
+  // outside it, cells are clamped to its border, which lists every face there may be.
+  const Eigen::Vector2d p = a.head<2>(), d = b.head<2>() - p;
+  int c = Col(p.x()), r = Row(p.y());
+  const int c_end = Col(b.x()), r_end = Row(b.y());
+  const int step_c = d.x() > 0 ? 1 : -1, step_r = d.y() > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double dt_c = std::abs(d.x()) > 1e-300 ? cell_ / std::abs(d.x()) : inf;
+  const double dt_r = std::abs(d.y()) > 1e-300 ? cell_ / std::abs(d.y()) : inf;
+  double t_c = std::abs(d.x()) > 1e-300
+                   ? (origin_.x() + (c + (step_c > 0 ? 1 : 0)) * cell_ - p.x()) / d.x()
+                   : inf;
+  double t_r = std::abs(d.y()) > 1e-300
+                   ? (origin_.y() + (r + (step_r > 0 ? 1 : 0)) * cell_ - p.y()) / d.y()
+                   : inf;
+  int prev_c = -1, prev_r = -1;
+  for (int guard = 0; guard < cols_ + rows_ + 2; ++guard) {
+    for (int i : cells_[static_cast<size_t>(r) * cols_ + c]) {
+      // A face met in the previous cell was tested there (the walk is contiguous in its box).
+      const Eigen::Vector4i& box = rectangles_[i];
+      if (prev_c >= box[0] && prev_c <= box[1] && prev_r >= box[2] && prev_r <= box[3]) continue;
+      if (test(i)) return true;
+    }
+    if (c == c_end && r == r_end) break;
+    prev_c = c, prev_r = r;
+    if (t_c < t_r) {
+      c += step_c;
+      t_c += dt_c;
+    } else {
+      r += step_r;
+      t_r += dt_r;
+    }
+    if (c < 0 || r < 0 || c >= cols_ || r >= rows_) break;
+  }
+  return false;
+}
+
+bool OcclusionTester::Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                              double tolerance) const {
+  const Face& face = faces_[i];
+  const Eigen::Vector3d dir = target - eye;
+  const Eigen::Vector3d lo = eye.cwiseMin(target), hi = eye.cwiseMax(target);
+  if ((face.box_max.array() < lo.array() - tolerance).any() ||
+      (face.box_min.array() > hi.array() + tolerance).any()) {
+    return false;
+  }
+  const double denom = face.normal.dot(dir);
+  if (std::abs(denom) < 1e-12) return false;  // parallel to the face
+  const double length = dir.norm();
+  const double t = (face.offset - face.normal.dot(eye)) / denom;
+  if (t <= 0.0 || t * length >= length - tolerance) return false;
+  const Eigen::Vector3d hit = eye + t * dir;
+  return InsidePolygon(face.polygon, Eigen::Vector2d(hit[face.axis_u], hit[face.axis_v]));
 }
 
 bool OcclusionTester::Blocked(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                               double tolerance) const {
-  const Eigen::Vector3d dir = target - eye;
-  const double length = dir.norm();
-  if (length <= tolerance) return false;
-  const Eigen::Vector3d lo = eye.cwiseMin(target), hi = eye.cwiseMax(target);
-  for (const Face& face : faces_) {
-    if ((face.box_max.array() < lo.array() - tolerance).any() ||
-        (face.box_min.array() > hi.array() + tolerance).any()) {
-      continue;
-    }
-    const double denom = face.normal.dot(dir);
-    if (std::abs(denom) < 1e-12) continue;  // parallel to the face
-    const double t = (face.offset - face.normal.dot(eye)) / denom;
-    if (t <= 0.0 || t * length >= length - tolerance) continue;
-    const Eigen::Vector3d hit = eye + t * dir;
-    if (InsidePolygon(face.polygon, Eigen::Vector2d(hit[face.axis_u], hit[face.axis_v]))) {
-      return true;
-    }
+  // A model of a few faces (one room) is quicker to test face by face than to walk.
+  if (faces_.size() <= kFacesWithoutGrid) return BlockedByAnyFace(eye, target, tolerance);
+  if ((target - eye).norm() <= tolerance) return false;
+  return AlongPlan(eye, target, [&](int i) { return Crosses(i, eye, target, tolerance); });
+}
+
+bool OcclusionTester::BlockedByAnyFace(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                                       double tolerance) const {
+  if ((target - eye).norm() <= tolerance) return false;
+  for (size_t i = 0; i < faces_.size(); ++i) {
+    if (Crosses(static_cast<int>(i), eye, target, tolerance)) return true;
   }
   return false;
 }

@@ -19,6 +19,10 @@ class OcclusionTester {
   // `target`; faces through `target` itself (within `tolerance` metres) do not count.
   bool Blocked(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                double tolerance = 1e-4) const;
+  // The same test against every face in turn, without the plan grid: the reference Blocked must
+  // equal.
+  bool BlockedByAnyFace(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                        double tolerance = 1e-4) const;
 
  private:
   struct Face {
@@ -28,7 +32,26 @@ class OcclusionTester {
     std::vector<Eigen::Vector2d> polygon;  // face corners in (axis_u, axis_v)
     Eigen::Vector3d box_min, box_max;      // bounding box, for a quick reject
   };
+  // True when face i crosses the open segment eye -> target before target (see Blocked).
+  bool Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+               double tolerance) const;
+  // Fills the plan grid below from the faces' boxes.
+  void BuildPlanGrid();
+  int Col(double x) const;
+  int Row(double y) const;
+  // Calls test(face index) for the faces whose plan box meets a cell that the plan projection of
+  // a -> b passes through, each once, cell by cell from a; stops when test returns true.
+  template <typename Test>
+  bool AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Test& test) const;
+
   std::vector<Face> faces_;
+  // A uniform grid over the faces' plan boxes: the faces meeting each cell, and per face the
+  // rectangle of cells [col_lo, col_hi] x [row_lo, row_hi] it is listed in.
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  double cell_ = 1.0;
+  int cols_ = 1, rows_ = 1;
+  std::vector<std::vector<int>> cells_;
+  std::vector<Eigen::Vector4i> rectangles_;
 };
 
 // The visible part of one model edge in an image.

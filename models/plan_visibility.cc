@@ -11,6 +11,8 @@ namespace {
 // Region points on an occluder's line count as touching it within this (metres), and a chord may
 // end this far past the occluder's ends (sight lines through its very end are measure zero).
 constexpr double kTouch = 1e-9;
+// Boxes this far apart (metres) hold no two points within kTouch, whatever the rounding.
+constexpr double kApart = 1e-6;
 
 double Support(const Ring2& points, const Eigen::Vector2d& n) {
   double best = -std::numeric_limits<double>::infinity();
@@ -38,6 +40,17 @@ void AddEdgeNormals(const Ring2& ring, std::vector<Eigen::Vector2d>* normals) {
 void AddDirection(const Eigen::Vector2d& v, std::vector<Eigen::Vector2d>* normals) {
   const double norm = v.norm();
   if (norm > 1e-15) normals->push_back(v / norm);
+}
+
+// False when the boxes of the region and the footprint are too far apart for the footprint to
+// meet the region or come within kTouch of it.
+bool MayTouch(const Ring2& region, const Ring2& footprint) {
+  Eigen::Vector2d r_lo = region.front(), r_hi = r_lo, f_lo = footprint.front(), f_hi = f_lo;
+  for (const Eigen::Vector2d& r : region)
+    r_lo = r_lo.cwiseMin(r), r_hi = r_hi.cwiseMax(r);
+  for (const Eigen::Vector2d& f : footprint)
+    f_lo = f_lo.cwiseMin(f), f_hi = f_hi.cwiseMax(f);
+  return (f_lo - r_hi).maxCoeff() <= kApart && (r_lo - f_hi).maxCoeff() <= kApart;
 }
 
 // A value in (-2, 2] that increases with atan2(y, x) over (-pi, pi] (the "diamond angle"), for
@@ -176,7 +189,11 @@ std::vector<Segment2> MergeCollinear(const std::vector<Segment2>& segments, doub
 
 bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
                   double margin) {
-  const Line2 line = Line2::Through(wall.a, wall.b);
+  return HiddenByWall(region, footprint, wall, Line2::Through(wall.a, wall.b), margin);
+}
+
+bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
+                  const Line2& line, double margin) {
   double r_lo = std::numeric_limits<double>::infinity(), r_hi = -r_lo, f_lo = r_lo, f_hi = -r_lo;
   for (const Eigen::Vector2d& r : region) {
     r_lo = std::min(r_lo, line.SignedDistance(r));
@@ -251,19 +268,27 @@ bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& sol
 }
 
 BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
+  return BearingsToFootprint(region, footprint, RingCentroid(region));
+}
+
+BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
+                                 const Eigen::Vector2d& region_centroid) {
   BearingRange range;
   range.all = true;
-  if (footprint.size() == 1) {
-    if (ConvexContains(region, footprint[0], kTouch)) return range;
-  } else {
-    double t0 = 0.0, t1 = 0.0;
-    const Segment2 s{footprint[0], footprint[1]};
-    if (ClipSegmentToConvex(region, s, &t0, &t1)) return range;
-    for (size_t i = 0; i < region.size(); ++i) {
-      const Segment2 edge{region[i], region[(i + 1) % region.size()]};
-      if (DistanceToSegment(edge.a, s) <= kTouch || DistanceToSegment(s.a, edge) <= kTouch ||
-          DistanceToSegment(s.b, edge) <= kTouch) {
-        return range;
+  const bool may_touch = MayTouch(region, footprint);
+  if (may_touch) {
+    if (footprint.size() == 1) {
+      if (ConvexContains(region, footprint[0], kTouch)) return range;
+    } else {
+      double t0 = 0.0, t1 = 0.0;
+      const Segment2 s{footprint[0], footprint[1]};
+      if (ClipSegmentToConvex(region, s, &t0, &t1)) return range;
+      for (size_t i = 0; i < region.size(); ++i) {
+        const Segment2 edge{region[i], region[(i + 1) % region.size()]};
+        if (DistanceToSegment(edge.a, s) <= kTouch || DistanceToSegment(s.a, edge) <= kTouch ||
+            DistanceToSegment(s.b, edge) <= kTouch) {
+          return range;
+        }
       }
     }
   }
@@ -273,14 +298,14 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
   Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
   for (const Eigen::Vector2d& f : footprint)
     f_mid += f / static_cast<double>(footprint.size());
-  const Eigen::Vector2d centre = f_mid - RingCentroid(region);
+  const Eigen::Vector2d centre = f_mid - region_centroid;
   const double reference = std::atan2(centre.y(), centre.x());
   double lo_key = std::numeric_limits<double>::infinity(), hi_key = -lo_key;
   Eigen::Vector2d lo_v = centre, hi_v = centre;
   for (const Eigen::Vector2d& f : footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
-      if (v.norm() <= kTouch) return range;
+      if (may_touch && v.norm() <= kTouch) return range;
       const double key = PseudoAngle(centre.dot(v), Cross2(centre, v));
       if (key < lo_key) lo_key = key, lo_v = v;
       if (key > hi_key) hi_key = key, hi_v = v;

@@ -45,6 +45,9 @@ std::vector<Segment2> MergeCollinear(const std::vector<Segment2>& segments, doub
 // side of the wall's line (touching it allowed), the footprint at least `margin` metres on the
 // other side, and the chord of their convex hull along the line inside the wall.
 bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall, double margin);
+// The same, given the wall's Line2::Through(wall.a, wall.b).
+bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
+                  const Line2& line, double margin);
 
 // True when every sight line from the region to the footprint passes through the interior of the
 // convex `solid` (a closed loop of occluding walls), robustly: for every direction n,
@@ -60,5 +63,8 @@ struct BearingRange {
   bool all = false;
 };
 BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint);
+// The same, given RingCentroid(region).
+BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
+                                 const Eigen::Vector2d& region_centroid);
 
 }  // namespace linetrack

@@ -85,6 +85,25 @@ int SegmentGrid::Row(double y) const {
   return ClampedIndex((y - origin_.y()) / cell_, rows_);
 }
 
+void SegmentGrid::BandExtent(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double y0,
+                             double y1, double* x_lo, double* x_hi) {
+  const Eigen::Vector2d& low = p.y() <= q.y() ? p : q;
+  const Eigen::Vector2d& high = p.y() <= q.y() ? q : p;
+  if (high.y() < y0 || low.y() > y1) return;
+  const double dy = high.y() - low.y();
+  // The ends of the part inside the band (a horizontal edge lies in it whole).
+  double t0 = 0.0, t1 = 1.0;
+  if (dy > 0.0) {
+    t0 = std::max(0.0, (y0 - low.y()) / dy);
+    t1 = std::min(1.0, (y1 - low.y()) / dy);
+  }
+  for (double t : {t0, t1}) {
+    const double x = low.x() + t * (high.x() - low.x());
+    *x_lo = std::min(*x_lo, x);
+    *x_hi = std::max(*x_hi, x);
+  }
+}
+
 std::vector<int> SegmentGrid::Near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
   ++query_;
   std::vector<int> out;

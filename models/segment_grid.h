@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -35,6 +36,35 @@ class SegmentGrid {
       }
       return false;
     });
+  }
+
+  // Calls visit(i) once for each segment registered in a cell that the convex polygon `ring`,
+  // grown by `margin` metres, meets (a superset of the segments within `margin` of it).
+  template <typename Visit>
+  void InConvex(const std::vector<Eigen::Vector2d>& ring, double margin, const Visit& visit) const {
+    ++query_;
+    Eigen::Vector2d lo = ring.front(), hi = lo;
+    for (const Eigen::Vector2d& p : ring)
+      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    for (int r = Row(lo.y() - margin); r <= Row(hi.y() + margin); ++r) {
+      // The polygon's x extent within this row's band: that of its edges clipped to the band.
+      const double y0 = std::max(lo.y(), origin_.y() + r * cell_ - margin);
+      const double y1 = std::min(hi.y(), origin_.y() + (r + 1) * cell_ + margin);
+      if (y0 > y1) continue;  // a row clamped onto a polygon outside the grid
+      double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
+      for (size_t k = 0; k < ring.size(); ++k) {
+        const Eigen::Vector2d &p = ring[k], &q = ring[(k + 1) % ring.size()];
+        BandExtent(p, q, y0, y1, &x_lo, &x_hi);
+      }
+      if (!(x_lo <= x_hi)) continue;
+      for (int c = Col(x_lo - margin); c <= Col(x_hi + margin); ++c) {
+        for (int i : cells_[static_cast<size_t>(r) * cols_ + c]) {
+          if (stamp_[i] == query_) continue;
+          stamp_[i] = query_;
+          visit(i);
+        }
+      }
+    }
   }
 
   // The parameter t >= min_t (along a -> a + t d, d of any length) of the first segment the ray
@@ -79,6 +109,9 @@ class SegmentGrid {
     }
     return false;
   }
+  // Widens [x_lo, x_hi] to the x of the part of segment p-q with y in [y0, y1].
+  static void BandExtent(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double y0, double y1,
+                         double* x_lo, double* x_hi);
   // Parameters [t0, t1] of a -> b inside the grid's box; false when it misses.
   bool ClipToGrid(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double* t0, double* t1) const;
 

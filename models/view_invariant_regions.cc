@@ -7,7 +7,6 @@
 #include <exception>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <thread>
 
 #include "models/convex_polygon.h"
@@ -16,6 +15,7 @@
 #include "models/plan_visibility.h"
 #include "models/segment_grid.h"
 #include "models/vir_cells.h"
+#include "models/vir_lists.h"
 
 namespace linetrack {
 namespace {
@@ -26,81 +26,15 @@ constexpr double kPlanTolerance = 1e-6;
 // loop of occluders with at most this many sides is a solid.
 constexpr double kEventRange = 15.0;
 constexpr int kMaxSolidSides = 16;
+// A cell split into at least this many regions keeps its edges' occluders: gathering them costs
+// about as much as a few walks along each sight line.
+constexpr int kRegionsToKeepOccluders = 8;
 
 // The floor-plan footprint of an edge: one point for a vertical edge, else its two end points.
 Ring2 Footprint(const ModelEdge& edge) {
   const Eigen::Vector2d a = edge.segment.a.head<2>(), b = edge.segment.b.head<2>();
   if ((b - a).norm() <= 1e-9) return {0.5 * (a + b)};
   return {a, b};
-}
-
-// The edges one storey's regions list: those within its height band can be hidden by its
-// occluders; those outside it (seen over the walls) are listed in every region.
-struct StoreyEdges {
-  std::vector<int> ids;
-  std::vector<Ring2> footprints;                                   // per entry of ids
-  std::vector<char> in_band;                                       // per entry of ids
-  double z_lo = 0.0, z_hi = 0.0;                                   // the cameras' band (metres)
-  const std::vector<std::vector<int>>* one_sided_faces = nullptr;  // OneSidedFacesOfEdges
-};
-
-// True when segments p-q and s meet (touching counts). `d_norm` and `e_norm` are |q - p| and
-// |s.b - s.a|.
-bool SegmentsMeet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double d_norm,
-                  const Segment2& s, double e_norm) {
-  const Eigen::Vector2d d = q - p, e = s.b - s.a;
-  // Signed areas s1, s2 of (d, s.a - p) and (d, s.b - p). Where the lines cross, s sits at
-  // u = s1 / (s1 - s2); with both ends on one side of line p-q farther than the tolerances below
-  // (1e-9 of u, kPlanTolerance for parallel segments), twice over for rounding, they cannot meet.
-  const double s1 = Cross2(d, s.a - p), s2 = Cross2(d, s.b - p);
-  const double clear = 2.0 * d_norm * std::max(kPlanTolerance, 1e-9 * e_norm);
-  if ((s1 > clear && s2 > clear) || (s1 < -clear && s2 < -clear)) return false;
-  const double denom = Cross2(d, e);
-  if (std::abs(denom) <= 1e-15 * d_norm * e_norm) {
-    return DistanceToSegment(p, s) <= kPlanTolerance || DistanceToSegment(q, s) <= kPlanTolerance;
-  }
-  const double t = Cross2(s.a - p, e) / denom, u = Cross2(s.a - p, d) / denom;
-  return t >= -1e-9 && t <= 1.0 + 1e-9 && u >= -1e-9 && u <= 1.0 + 1e-9;
-}
-
-// The occluders and solids of one storey, in grids along which sight lines are walked.
-struct StoreyOccluders {
-  SegmentGrid walls;
-  std::vector<double> wall_lengths;  // per wall of `walls` (metres)
-  std::vector<Ring2> solids;
-  SegmentGrid solid_sides;             // the solids' sides
-  std::vector<int> solid_of_side;      // per side: its solid
-  mutable std::vector<unsigned> seen;  // per solid: the last visibility test that met it
-  mutable unsigned test = 0;
-};
-
-// True when an occluder or a solid hides the whole footprint from the whole region: only those
-// crossing the line between their centres can (docs/models.md).
-bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footprint,
-            const StoreyOccluders& o, double margin) {
-  Eigen::Vector2d to = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& f : footprint)
-    to += f / static_cast<double>(footprint.size());
-  int crossed = 0;
-  const double sight_length = (to - from).norm();
-  const bool by_wall = o.walls.Along(from, to, [&](int i) {
-    const Segment2& wall = o.walls.segments()[i];
-    if (!SegmentsMeet(from, to, sight_length, wall, o.wall_lengths[i])) return false;
-    ++crossed;
-    return HiddenByWall(region, footprint, wall, margin);
-  });
-  if (by_wall) return true;
-  // The sight line between the centres is clear: the footprint is in sight. (A solid's sides are
-  // occluders: the line meets none of them either.)
-  if (crossed == 0) return false;
-  ++o.test;
-  const bool by_solid = o.solid_sides.Along(from, to, [&](int side) {
-    const int solid = o.solid_of_side[side];
-    if (o.seen[solid] == o.test) return false;
-    o.seen[solid] = o.test;
-    return HiddenBySolid(region, footprint, o.solids[solid], margin);
-  });
-  return by_solid;
 }
 
 // Per model edge, the faces it bounds when all of them are one-sided (no camera sees their back):
@@ -125,44 +59,6 @@ std::vector<std::vector<int>> OneSidedFacesOfEdges(const WireframeModel& model) 
     if (edge.from_line || seen_behind[edge.id]) faces[edge.id].clear();
   }
   return faces;
-}
-
-// True when the region (cameras between z_lo and z_hi) lies behind the face's plane by `margin`.
-bool Behind(const ModelFace& face, const Ring2& region, double z_lo, double z_hi, double margin) {
-  if (face.vertical) {
-    const Eigen::Vector2d n = face.normal.head<2>();
-    return std::all_of(region.begin(), region.end(),
-                       [&](const Eigen::Vector2d& p) { return n.dot(p) - face.offset < -margin; });
-  }
-  if (face.horizontal) {
-    const double z = face.corners.front().z();
-    return face.normal.z() > 0.0 ? z > z_hi + margin : z < z_lo - margin;
-  }
-  return false;
-}
-
-// The visibility list of a region among the candidate edges (the storey's, or the list of the
-// cell it was split from: a region inside a cell sees no more than the cell).
-std::vector<RegionEdge> VisibilityList(const Ring2& region, const WireframeModel& model,
-                                       const StoreyEdges& edges, const std::vector<int>& candidates,
-                                       const StoreyOccluders& occluders, double margin) {
-  std::vector<RegionEdge> visible;
-  visible.reserve(candidates.size());
-  const Eigen::Vector2d centre = RingCentroid(region);
-  for (int k : candidates) {
-    const ModelEdge& edge = model.edges()[edges.ids[k]];
-    const std::vector<int>& faces = (*edges.one_sided_faces)[edge.id];
-    if (!faces.empty() && std::all_of(faces.begin(), faces.end(), [&](int f) {
-          return Behind(model.faces()[f], region, edges.z_lo, edges.z_hi, margin);
-        })) {
-      continue;
-    }
-    const Ring2& footprint = edges.footprints[k];
-    if (edges.in_band[k] && Hidden(region, centre, footprint, occluders, margin)) continue;
-    const BearingRange range = BearingsToFootprint(region, footprint);
-    visible.push_back({edge.id, range.min, range.max, range.all});
-  }
-  return visible;
 }
 
 // Distinct floor-plan points of the ends of the edges `ids`.
@@ -349,9 +245,11 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   edges.z_lo = z_lo;
   edges.z_hi = z_hi;
   edges.one_sided_faces = &one_sided;
-  StoreyOccluders occluders{SegmentGrid(walls), {}, {}, SegmentGrid({}), {}, {}, 0};
-  for (const Segment2& wall : occluders.walls.segments())
+  StoreyOccluders occluders{SegmentGrid(walls), {}, {}, {}, SegmentGrid({}), {}, {}, 0};
+  for (const Segment2& wall : occluders.walls.segments()) {
     occluders.wall_lengths.push_back((wall.b - wall.a).norm());
+    occluders.wall_lines.push_back(Line2::Through(wall.a, wall.b));
+  }
   occluders.solids = Solids(walls, cells, kMaxSolidSides);
   if (options.event_rays) {
     EventRayOptions rays;
@@ -374,16 +272,16 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   occluders.solid_sides = SegmentGrid(std::move(sides));
   occluders.seen.assign(occluders.solids.size(), 0);
   occluders_.insert(occluders_.end(), walls.begin(), walls.end());
-  // The initial cells' lists first; a region split from one tests only its cell's list.
-  std::vector<int> all(edges.ids.size());
-  std::iota(all.begin(), all.end(), 0);
-  std::vector<std::vector<int>> parent_lists(initial.size());
+  // The initial cells' lists first; a region split from one tests only its cell's list. A cell
+  // split into many regions keeps each edge's occluders for them.
+  std::vector<int> regions_of(initial.size(), 0);
+  for (const Cell& cell : cells)
+    ++regions_of[cell.parent];
+  std::vector<CellList> cell_lists(initial.size());
   ForEach(initial.size(), options.threads, occluders, [&](size_t i, const StoreyOccluders& own) {
-    for (const RegionEdge& e :
-         VisibilityList(initial[i].ring, model, edges, all, own, options.hidden_margin)) {
-      parent_lists[i].push_back(static_cast<int>(
-          std::lower_bound(edges.ids.begin(), edges.ids.end(), e.edge_id) - edges.ids.begin()));
-    }
+    const CellOccluders keep =
+        regions_of[i] >= kRegionsToKeepOccluders ? CellOccluders::kKeep : CellOccluders::kNone;
+    cell_lists[i] = CellVisibility(initial[i].ring, model, edges, own, options.hidden_margin, keep);
   });
   const size_t first = regions_.size();
   regions_.resize(first + cells.size());
@@ -391,8 +289,10 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
     ViewRegion& region = regions_[first + i];
     region.polygon.vertices = cells[i].ring;
     region.storey = s;
-    region.visible = VisibilityList(cells[i].ring, model, edges, parent_lists[cells[i].parent], own,
-                                    options.hidden_margin);
+    region.visible = options.direct_lists
+                         ? DirectVisibility(cells[i], model, edges, own, options.hidden_margin)
+                         : RegionVisibility(cells[i], model, edges, cell_lists[cells[i].parent],
+                                            own, options.hidden_margin);
   });
 }
 

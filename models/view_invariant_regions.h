@@ -72,6 +72,10 @@ struct ViewInvariantRegionsOptions {
   // An edge counts as hidden only when the occluders block every sight line to it by at least
   // this much (metres); keeps the lists conservative against rounding and grazing sight lines.
   double hidden_margin = 1e-3;
+  // Test every region against every edge of its storey, walking each sight line through the
+  // walls, instead of only the edges its cell sees against the occluders that can hide each from
+  // a part of the cell: slow; the reference the tests hold the lists to.
+  bool direct_lists = false;
   // Threads computing the regions' visibility lists (0: one per hardware thread). The lists do
   // not depend on it.
   int threads = 0;

@@ -279,25 +279,27 @@ std::string Row(const std::string& matcher, const Tally& t) {
   return row.str();
 }
 
-// One scene of the global series for --diagnose: the truth verified in a search centred on its
-// own heading (its evidence, as the matcher would score it) against every search's finalists,
-// and how far the truth's heading is from the nearest search's.
+// One scene of the global series for --diagnose: the truth verified by a peak's search centred on
+// the true pose (its evidence, as the matcher would score it) against every verified peak's
+// finalists, and how far the truth's heading is from the nearest search's.
 nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const Localizer& tree,
                                            const SyntheticScene& scene, const GlobalResult& r,
                                            Outcome outcome) {
-  HeadingSearch at_truth;
+  PositionPeak at_truth;
+  at_truth.position = {scene.truth.x, scene.truth.y};
   at_truth.heading = scene.truth.heading;
-  at_truth.heading_bound = DegToRad(GlobalOptions().min_heading_bound_deg);
   const TruthDiagnosis d =
-      DiagnoseTruth(tree, global.SearchProblem({scene.lines, scene.height, scene.tilt}, at_truth),
+      DiagnoseTruth(tree, global.PeakProblem({scene.lines, scene.height, scene.tilt}, at_truth),
                     scene.truth.Planar(), scene.matches);
   double nearest_deg = 180.0;
   nlohmann::ordered_json searches = nlohmann::ordered_json::array();
   for (const HeadingSearch& s : r.searches) {
     nearest_deg =
         std::min(nearest_deg, std::abs(RadToDeg(WrapAngle(s.heading - scene.truth.heading))));
+  }
+  for (const PeakVerification& v : r.verifications) {
     nlohmann::ordered_json finalists = nlohmann::ordered_json::array();
-    for (const Finalist& f : s.result.finalists) {
+    for (const Finalist& f : v.result.finalists) {
       std::set<int> lines;
       for (const auto& m : f.matches)
         lines.insert(m.second);
@@ -305,13 +307,13 @@ nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const 
                            f.evidence.Score(), f.matched_edges, f.evidence.Support(), lines.size(),
                            f.evidence.lines_nats, f.evidence.edges_nats});
     }
-    searches.push_back({{"heading_deg", RadToDeg(WrapAngle(s.heading))},
-                        {"bound_deg", RadToDeg(s.heading_bound)},
-                        {"found", s.result.found},
-                        {"reason", s.result.reason},
-                        {"budget_exhausted", s.result.budget_exhausted},
-                        {"completed_bound", s.result.tree_completed_bound},
-                        {"unexplained_bound", s.result.unexplained_completed_bound},
+    searches.push_back({{"heading_deg", RadToDeg(WrapAngle(r.searches[v.search].heading))},
+                        {"bound_deg", RadToDeg(r.searches[v.search].heading_bound)},
+                        {"peak",
+                         {v.peak.position.x(), v.peak.position.y(),
+                          RadToDeg(WrapAngle(v.peak.heading)), v.peak.votes}},
+                        {"found", v.result.found},
+                        {"reason", v.result.reason},
                         {"finalists", finalists}});
   }
   return {{"scene", scene.index},
@@ -343,8 +345,8 @@ Tally RunGlobalSeries(const Localizer& tree, const ModelDirections& directions,
     const double ms = MillisecondsSince(start);
     LocalizationResult shown = r.found ? r.best : LocalizationResult();
     shown.hypotheses = 0;
-    for (const HeadingSearch& h : r.searches)
-      shown.hypotheses += h.result.hypotheses;
+    for (const PeakVerification& v : r.verifications)
+      shown.hypotheses += v.result.hypotheses;
     const Outcome outcome = Score(scene, shown, ms, &tally);
     *ambiguous += r.ambiguous ? 1 : 0;
     if (diagnosis != nullptr) {

@@ -30,7 +30,11 @@ bool GlobalOptions::Check(std::string* why) const {
     *why = "min_support must be in [0, 1]";
     return false;
   }
-  return true;
+  if (!(verify_delta_t_m > 0.0) || !(verify_delta_phi_deg > 0.0) || max_verified_peaks < 1) {
+    *why = "verify_delta_t_m, verify_delta_phi_deg and max_verified_peaks must be positive";
+    return false;
+  }
+  return vote.Check(why);
 }
 
 GlobalOptions GlobalOptionsFor(const LocalizerOptions& localizer) {
@@ -54,10 +58,7 @@ std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidat
                                     DegToRad(options.min_heading_bound_deg),
                                     DegToRad(options.max_heading_bound_deg));
     for (double heading : h.headings) {
-      HeadingSearch s;
-      s.heading = heading;
-      s.heading_bound = bound;
-      searches.push_back(std::move(s));
+      searches.push_back({heading, bound});
     }
   }
   return searches;
@@ -65,17 +66,17 @@ std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidat
 
 namespace {
 
-// A finalist of one search: its pose, evidence and whether that search accepted it.
+// A finalist of one verification: its pose, evidence and whether that verification accepted it.
 struct Explanation {
   Pose3Dof pose;
-  double score = 0.0;  // evidence (nats)
-  int search = -1;
-  bool accepted = false;  // the search's own answer
+  double score = 0.0;     // evidence (nats)
+  int search = -1;        // index into the verifications
+  bool accepted = false;  // the verification's own answer
 };
 
-// Every finalist of every search (those that accepted no pose included: their best may be the
-// truth, too weakly seen), best first, one per distinct pose.
-std::vector<Explanation> Explanations(const std::vector<HeadingSearch>& searches,
+// Every finalist of every verification (those that accepted no pose included: their best may be
+// the truth, too weakly seen), best first, one per distinct pose.
+std::vector<Explanation> Explanations(const std::vector<PeakVerification>& searches,
                                       const VerificationOptions& vo) {
   std::vector<Explanation> all;
   for (size_t i = 0; i < searches.size(); ++i) {
@@ -101,13 +102,13 @@ std::vector<Explanation> Explanations(const std::vector<HeadingSearch>& searches
 // pose comes within the ambiguity margin and it observes min_support of its predicted outline;
 // "ambiguous" with the rivals when a distinct pose comes within the margin; else the reason.
 void Decide(const VerificationOptions& vo, double min_support, GlobalResult* out) {
-  const std::vector<Explanation> explanations = Explanations(out->searches, vo);
+  const std::vector<Explanation> explanations = Explanations(out->verifications, vo);
   if (explanations.empty()) {
     out->reason = "no heading candidate's search found a plausible pose";
     return;
   }
   const Explanation& best = explanations.front();
-  const LocalizationResult& best_search = out->searches[best.search].result;
+  const LocalizationResult& best_search = out->verifications[best.search].result;
   std::vector<Pose3Dof> rivals;
   for (const Explanation& e : explanations) {
     if (e.score > best.score - vo.ambiguity_nats) rivals.push_back(e.pose);
@@ -136,39 +137,50 @@ void Decide(const VerificationOptions& vo, double min_support, GlobalResult* out
   if (out->ambiguous) out->rivals = rivals;
 }
 
+// The localizer's navigable area; throws InputError when it has none.
+const NavigableArea& AreaOf(const Localizer& localizer) {
+  if (localizer.area() == nullptr) {
+    throw InputError("global localisation needs the model's navigable area");
+  }
+  return *localizer.area();
+}
+
+// The vote's options with the camera's focal length, checked with the others.
+PositionVoteOptions VoteOptions(const GlobalOptions& options, const Localizer& localizer) {
+  std::string why;
+  if (!options.Check(&why)) throw InputError("global localisation options: " + why);
+  PositionVoteOptions vote = options.vote;
+  vote.tolerance.focal_px = 0.5 * (localizer.camera().px + localizer.camera().py);
+  return vote;
+}
+
 }  // namespace
 
 GlobalLocalizer::GlobalLocalizer(const Localizer& localizer, const ModelDirections& directions,
                                  const GlobalOptions& options)
-    : localizer_(localizer), directions_(directions), options_(options) {
-  std::string why;
-  if (!options_.Check(&why)) throw InputError("global localisation options: " + why);
-  if (localizer_.area() == nullptr) {
-    throw InputError("global localisation needs the model's navigable area");
-  }
+    : localizer_(localizer),
+      directions_(directions),
+      options_(options),
+      vote_(localizer.model(), AreaOf(localizer), VoteOptions(options, localizer)) {
   if (directions_.angles.empty()) {
     throw InputError("global localisation needs the model's horizontal directions");
   }
 }
 
-LocalizationProblem GlobalLocalizer::SearchProblem(const GlobalProblem& problem,
-                                                   const HeadingSearch& search) const {
+LocalizationProblem GlobalLocalizer::PeakProblem(const GlobalProblem& problem,
+                                                 const PositionPeak& peak) const {
   LocalizationProblem local;
   local.lines = problem.lines;
   local.height = problem.height;
   local.tilt = problem.tilt;
-  // The whole navigable area: the disk around its bounding box.
-  const Eigen::Vector2d lo = localizer_.area()->BoundsMin(), hi = localizer_.area()->BoundsMax();
-  local.prior = {0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), search.heading};
-  local.delta_t = 0.5 * (hi - lo).norm();
-  local.delta_phi = search.heading_bound;
+  local.prior = {peak.position.x(), peak.position.y(), peak.heading};
+  local.delta_t = options_.verify_delta_t_m;
+  local.delta_phi = DegToRad(options_.verify_delta_phi_deg);
   return local;
 }
 
 GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
-  HeadingSearch probe;
-  probe.heading_bound = DegToRad(options_.min_heading_bound_deg);
-  CheckProblem(SearchProblem(problem, probe));
+  CheckProblem(PeakProblem(problem, PositionPeak()));
 
   GlobalResult out;
   out.headings = EstimateHeading(problem.lines, localizer_.camera(), problem.tilt, directions_,
@@ -178,8 +190,25 @@ GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
     return out;
   }
   out.searches = PlanHeadingSearches(out.headings, options_);
-  for (HeadingSearch& s : out.searches)
-    s.result = localizer_.Localize(SearchProblem(problem, s));
+  const std::vector<ObservedLine> lines =
+      PrepareLines(problem.lines, localizer_.camera(), problem.tilt, localizer_.options().noise,
+                   localizer_.options().tree.vertical_gate_sigmas);
+  // Every search's peaks, the best max_verified_peaks of them (by votes) verified.
+  std::vector<PeakVerification> peaks;
+  for (size_t i = 0; i < out.searches.size(); ++i) {
+    const HeadingSearch& s = out.searches[i];
+    for (const PositionPeak& peak : vote_.Peaks(lines, problem.height, s.heading, s.heading_bound))
+      peaks.push_back({static_cast<int>(i), peak, {}});
+  }
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const PeakVerification& a, const PeakVerification& b) {
+                     return a.peak.votes > b.peak.votes;
+                   });
+  if (static_cast<int>(peaks.size()) > options_.max_verified_peaks)
+    peaks.resize(options_.max_verified_peaks);
+  for (PeakVerification& v : peaks)
+    v.result = localizer_.Localize(PeakProblem(problem, v.peak));
+  out.verifications = std::move(peaks);
   Decide(localizer_.options().verification, options_.min_support, &out);
   return out;
 }

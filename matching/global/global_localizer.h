@@ -1,13 +1,14 @@
 // Localisation with no prior (the kidnapped robot): the heading candidates of the vanishing
-// points (matching/heading/) turn "anywhere, any heading" into a few searches of the
-// interpretation tree over the whole navigable area, each with the heading known within a few
-// degrees; their answers are compared, and a hall that repeats itself gives an honest
-// "ambiguous" with the rival poses. docs/global.md.
+// points (matching/heading/) turn "anywhere, any heading" into a few heading searches; in each,
+// the correspondences' loci vote for the camera position (position_vote.h) and the local matcher
+// verifies the vote's peaks; all verified poses are compared, and a hall that repeats itself
+// gives an honest "ambiguous" with the rival poses. docs/global.md.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "matching/global/position_vote.h"
 #include "matching/heading/heading_estimator.h"
 #include "matching/localizer.h"
 
@@ -28,6 +29,13 @@ struct GlobalOptions {
   // (PoseEvidence::Support): over the whole hall, a pose that explains part of the image by a
   // partial repetition of the building predicts edges the image does not have (docs/global.md).
   double min_support = 0.6;
+  // The position vote of each heading search, and the local matcher's prior around each of its
+  // peaks: delta_t (metres) and delta_phi (degrees).
+  PositionVoteOptions vote;
+  double verify_delta_t_m = 0.75;
+  double verify_delta_phi_deg = 5.0;
+  // The peaks verified: the best of all searches' peaks by votes.
+  int max_verified_peaks = 24;
 
   bool Check(std::string* why) const;
 };
@@ -39,10 +47,16 @@ struct GlobalProblem {
   double tilt = 0.0;            // radians, positive down
 };
 
-// One search of the tree: the heading it was centred on and its answer.
+// One heading search: the heading it is centred on and its bound.
 struct HeadingSearch {
   double heading = 0.0;        // radians
   double heading_bound = 0.0;  // radians
+};
+
+// One peak of a heading search's position vote and the local matcher's answer around it.
+struct PeakVerification {
+  int search = -1;  // index into GlobalResult::searches
+  PositionPeak peak;
   LocalizationResult result;
 };
 
@@ -56,6 +70,7 @@ struct GlobalResult {
   std::string reason;          // why no pose (empty when found)
   HeadingCandidates headings;  // the vanishing points' answer
   std::vector<HeadingSearch> searches;
+  std::vector<PeakVerification> verifications;  // every search's peaks, verified
 };
 
 // Options whose heading vote assumes the matcher's line noise (its angle and offset standard
@@ -77,15 +92,17 @@ class GlobalLocalizer {
   // Throws InputError when the problem is malformed (NaN, empty or zero-length lines).
   GlobalResult Localize(const GlobalProblem& problem) const;
 
-  // The local problem of one search: the disk around the navigable area's bounding box, the
-  // search's heading and bound.
-  LocalizationProblem SearchProblem(const GlobalProblem& problem,
-                                    const HeadingSearch& search) const;
+  // The local problem verifying one peak: the prior at the peak, options' verify_delta_t_m and
+  // verify_delta_phi_deg.
+  LocalizationProblem PeakProblem(const GlobalProblem& problem, const PositionPeak& peak) const;
+
+  const PositionVote& vote() const { return vote_; }
 
  private:
   const Localizer& localizer_;
   const ModelDirections& directions_;
   GlobalOptions options_;
+  PositionVote vote_;
 };
 
 }  // namespace linetrack

@@ -140,6 +140,35 @@ TEST_F(Building, PassesTheModelChecks) {
   EXPECT_TRUE(findings.empty()) << findings.front().message;
 }
 
+// On a small building (2 storeys of 2 rooms a side), the regions' lists equal, bit for bit,
+// those of testing every edge of the storey directly (ViewInvariantRegionsOptions::direct_lists).
+TEST(SmallBuilding, RegionListsEqualTheDirectTest) {
+  BuildingSpec spec;
+  spec.rooms_per_side = 2;
+  const WireframeModel model = WireframeModel::FromCao(GenerateBuilding(spec).cao);
+  const NavigableArea area = NavigableArea::FromModel(model);
+  ViewInvariantRegionsOptions direct;
+  direct.direct_lists = true;
+  const ViewInvariantRegions a = ViewInvariantRegions::Build(model, area);
+  const ViewInvariantRegions b = ViewInvariantRegions::Build(model, area, direct);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 100);
+  size_t entries = 0;
+  for (int r = 0; r < a.size(); ++r) {
+    const ViewRegion &x = a.regions()[r], &y = b.regions()[r];
+    ASSERT_EQ(x.polygon.vertices, y.polygon.vertices) << r;
+    ASSERT_EQ(x.visible.size(), y.visible.size()) << r;
+    for (size_t k = 0; k < x.visible.size(); ++k) {
+      const RegionEdge &e = x.visible[k], &f = y.visible[k];
+      EXPECT_TRUE(e.edge_id == f.edge_id && e.bearing_min == f.bearing_min &&
+                  e.bearing_max == f.bearing_max && e.all_bearings == f.all_bearings)
+          << "region " << r << " entry " << k;
+    }
+    entries += x.visible.size();
+  }
+  EXPECT_GT(entries, 0u);
+}
+
 TEST(BuildingAlone, EveryRoomAloneEnclosesItsSpace) {
   const BuildingSpec spec;
   const SyntheticBuilding building = GenerateBuilding(spec);

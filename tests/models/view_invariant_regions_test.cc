@@ -189,17 +189,11 @@ INSTANTIATE_TEST_SUITE_P(BundledModels, RegionsPartition,
                          ::testing::Combine(::testing::Values("hall.cao", "room.cao"),
                                             ::testing::Values(0.0, 1.0)));
 
-// The lists are computed on several threads: any number gives the same regions, bit for bit.
-TEST(ViewInvariantRegions, ThreadsDoNotChangeTheRegions) {
-  const WireframeModel model = WireframeModel::Load(kModels + "/office.cao");
-  ViewInvariantRegionsOptions one, three;
-  one.threads = 1;
-  three.threads = 3;
-  const Built a = BuildFor(model, one), b = BuildFor(model, three);
-  ASSERT_EQ(a.vir.size(), b.vir.size());
-  ASSERT_GT(a.vir.size(), 3 * 64);  // enough regions for three threads
-  for (int r = 0; r < a.vir.size(); ++r) {
-    const ViewRegion &x = a.vir.regions()[r], &y = b.vir.regions()[r];
+// The same polygons and lists, bit for bit.
+void ExpectSameRegions(const ViewInvariantRegions& a, const ViewInvariantRegions& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (int r = 0; r < a.size(); ++r) {
+    const ViewRegion &x = a.regions()[r], &y = b.regions()[r];
     EXPECT_EQ(x.polygon.vertices, y.polygon.vertices) << r;
     ASSERT_EQ(x.visible.size(), y.visible.size()) << r;
     for (size_t k = 0; k < x.visible.size(); ++k) {
@@ -208,6 +202,31 @@ TEST(ViewInvariantRegions, ThreadsDoNotChangeTheRegions) {
       EXPECT_EQ(x.visible[k].bearing_max, y.visible[k].bearing_max);
       EXPECT_EQ(x.visible[k].all_bearings, y.visible[k].all_bearings);
     }
+  }
+}
+
+// The lists are computed on several threads: any number gives the same regions, bit for bit.
+TEST(ViewInvariantRegions, ThreadsDoNotChangeTheRegions) {
+  const WireframeModel model = WireframeModel::Load(kModels + "/office.cao");
+  ViewInvariantRegionsOptions one, three;
+  one.threads = 1;
+  three.threads = 3;
+  const Built a = BuildFor(model, one), b = BuildFor(model, three);
+  ASSERT_GT(a.vir.size(), 3 * 64);  // enough regions for three threads
+  ExpectSameRegions(a.vir, b.vir);
+}
+
+// A region tests only its cell's edges against the occluders that can hide each from a part of
+// the cell: the same lists, bit for bit, as testing every edge of the storey directly.
+TEST(ViewInvariantRegions, ListsEqualTheDirectTest) {
+  for (const char* name : {"hall.cao", "office.cao"}) {
+    SCOPED_TRACE(name);
+    const WireframeModel model = WireframeModel::Load(kModels + "/" + name);
+    ViewInvariantRegionsOptions direct;
+    direct.direct_lists = true;
+    const Built a = BuildFor(model), b = BuildFor(model, direct);
+    ASSERT_GT(a.vir.size(), 100);
+    ExpectSameRegions(a.vir, b.vir);
   }
 }
 
