@@ -52,14 +52,24 @@ function(linetrack_add_test_pch)
   target_precompile_headers(linetrack_test_pch PRIVATE <gtest/gtest.h> ${LINETRACK_PCH_HEADERS})
 endfunction()
 
+# The whole binary as one ctest test `PREFIX.NAME`, with the binary's ctest properties.
+function(linetrack_add_grouped_test name prefix properties)
+  add_test(NAME ${prefix}.${name} COMMAND ${name} WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+  # A binary that runs no test exits 0: fail then.
+  set_tests_properties(${prefix}.${name} PROPERTIES
+    FAIL_REGULAR_EXPRESSION "\\[  PASSED  \\] 0 tests" ${properties})
+endfunction()
+
 # linetrack_add_test(NAME models_cao_reader SRCS cao_reader_test.cc LINK linetrack_models)
 # Test names read like `models.CaoReader.Parses...` in ctest. Optional PROPERTIES are ctest
 # properties for every test of the binary (e.g. LABELS aravis RESOURCE_LOCK gige_port; COST puts
 # the slow binaries first in a parallel ctest run). Optional SUITES are test suites that ctest
 # runs as one test each (`PREFIX.Suite`), in one process, so that a suite's SetUpTestSuite does
-# its expensive set-up once; every other test is a ctest test of its own.
+# its expensive set-up once; every other test is a ctest test of its own. A binary marked GROUPED
+# (many light tests) is one ctest test when LINETRACK_GROUP_TESTS is on: the sanitizer build, where
+# each process start costs about a third of a second.
 function(linetrack_add_test)
-  cmake_parse_arguments(ARG "" "NAME;PREFIX" "SRCS;LINK;PROPERTIES;SUITES" ${ARGN})
+  cmake_parse_arguments(ARG "GROUPED" "NAME;PREFIX" "SRCS;LINK;PROPERTIES;SUITES" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK} GTest::gtest GTest::gtest_main)
   target_include_directories(${ARG_NAME} PRIVATE ${LINETRACK_SOURCE_DIR})  # tests/support/
@@ -72,6 +82,10 @@ function(linetrack_add_test)
   if(LINETRACK_SANITIZE)  # leaks inside third-party libraries only; see the file
     list(APPEND properties ENVIRONMENT
          "LSAN_OPTIONS=suppressions=${LINETRACK_SOURCE_DIR}/tests/lsan_suppressions.txt")
+  endif()
+  if(ARG_GROUPED AND LINETRACK_GROUP_TESTS)
+    linetrack_add_grouped_test(${ARG_NAME} ${ARG_PREFIX} "${properties}")
+    return()
   endif()
   set(extra_properties)
   if(properties)
