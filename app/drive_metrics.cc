@@ -41,6 +41,9 @@ std::string Percent(int part, int whole) {
   return whole > 0 ? Fixed(100.0 * part / whole, 1) + " %" : "n/a";
 }
 
+// The source of a pose carried by the odometry (SequenceTracker's coasting).
+constexpr const char* kCoastedSource = "odometry";
+
 bool Beyond(const ReplayedFrame& f, double metres, double degrees) {
   return f.translation_error_m.value_or(0.0) > metres ||
          f.rotation_error_deg.value_or(0.0) > degrees;
@@ -103,6 +106,7 @@ std::vector<ReplayedFrame> ParseReplayFrames(const std::string& text, const std:
     f.frame = std::lround(OptionalNumber(field("frame"), where).value_or(-1.0));
     f.t = OptionalNumber(field("time"), where).value_or(0.0);
     f.status = field("status");
+    if (column.count("source")) f.source = field("source");
     f.step_ms = OptionalNumber(field("time_ms"), where).value_or(0.0);
     f.translation_error_m = OptionalNumber(field("translation_error_m"), where);
     f.rotation_error_deg = OptionalNumber(field("rotation_error_deg"), where);
@@ -158,6 +162,7 @@ DriveMetrics ComputeDriveMetrics(const std::vector<FrameTruth>& truth,
     ++m.poses;
     m.observable_with_pose += observable;
     m.observable_tracking += observable && tracking;
+    m.observable_tracking_coasted += observable && tracking && f.source == kCoastedSource;
     m.poses_unobservable += !observable;
     m.beyond_near += Beyond(f, options.near_m, options.near_deg);
     m.tracking_beyond_near += f.status == "tracking" && Beyond(f, options.near_m, options.near_deg);
@@ -186,7 +191,7 @@ DriveMetrics ComputeDriveMetrics(const std::vector<FrameTruth>& truth,
       if (r.first_observable < 0 && t.observable) r.first_observable = t.frame;
       if (r.first_observable < 0) continue;
       const auto it = replay_of.find(t.frame);
-      if (it != replay_of.end() && it->second->has_pose &&
+      if (it != replay_of.end() && it->second->has_pose && it->second->source != kCoastedSource &&
           !Beyond(*it->second, options.near_m, options.near_deg)) {
         r.recovered = t.frame;
         r.frames_to_recover = static_cast<int>(t.frame - r.first_observable);
@@ -220,6 +225,10 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
   row("availability: observable frames with a `tracking` pose",
       [](const DriveMetrics& m, const auto&) {
         return Percent(m.observable_tracking, m.observable);
+      });
+  row("... of which coasted on the odometry (no image fix)",
+      [](const DriveMetrics& m, const auto&) {
+        return Percent(m.observable_tracking_coasted, m.observable);
       });
   row("poses beyond " + near, [](const DriveMetrics& m, const auto&) {
     return std::to_string(m.beyond_near) + " of " + std::to_string(m.poses);
@@ -265,6 +274,11 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
                                   Fixed(100.0 * m.median_error_m, 2) + " cm"
                             : "n/a";
   });
+  row("protection level (position) p50 / p90", [](const DriveMetrics& m, const auto&) {
+    return m.nees_within_99 ? Fixed(100.0 * m.protection_p50_m, 1) + " / " +
+                                  Fixed(100.0 * m.protection_p90_m, 1) + " cm"
+                            : "n/a";
+  });
   row("sigma x p50 / p90; sigma heading p50", [](const DriveMetrics& m, const auto&) {
     return m.nees_within_99
                ? Fixed(100.0 * m.sigma_x_p50_m, 2) + " / " + Fixed(100.0 * m.sigma_x_p90_m, 2) +
@@ -306,6 +320,8 @@ void AddIntegrityFigures(const nlohmann::json& integrity, DriveMetrics* m) {
   m->sigma_x_p50_m = p("sigma_x_m", "p50");
   m->sigma_x_p90_m = p("sigma_x_m", "p90");
   m->sigma_heading_p50_deg = p("sigma_heading_deg", "p50");
+  m->protection_p50_m = p("protection_level_m", "p50");
+  m->protection_p90_m = p("protection_level_m", "p90");
 }
 
 std::string FormatWorstFrames(const DriveMetrics& metrics, const std::vector<FrameTruth>& truth,

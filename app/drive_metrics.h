@@ -18,7 +18,8 @@ namespace linetrack::app {
 struct ReplayedFrame {
   long frame = 0;
   double t = 0.0;
-  std::string status;  // initialising, tracking, lost, relocalised (and later statuses)
+  std::string status;  // the integrity status: tracking, degraded, lost
+  std::string source;  // where the pose came from ("odometry": coasted); empty without the column
   double step_ms = 0.0;
   bool has_pose = false;                      // an error was measured: the frame has a pose
   std::optional<double> translation_error_m;  // camera centre against the ground truth
@@ -42,7 +43,8 @@ struct DriveMetricsOptions {
 struct BlackoutRecovery {
   long first = 0, last = 0;    // the covered frames
   long first_observable = -1;  // the first observable frame after them (-1: none)
-  long recovered = -1;         // from there, the first frame with a pose within near bounds
+  // From there, the first frame with an image pose (not coasted) within near bounds.
+  long recovered = -1;
   int frames_to_recover = -1;  // recovered - first_observable; -1 when never
 };
 
@@ -50,7 +52,8 @@ struct DriveMetrics {
   int frames = 0;
   int observable = 0;
   int observable_with_pose = 0;
-  int observable_tracking = 0;  // observable frames with a pose whose status is `tracking`
+  int observable_tracking = 0;          // observable frames with a pose whose status is `tracking`
+  int observable_tracking_coasted = 0;  // ... of which the odometry carried (source odometry)
   int poses = 0;
   int poses_unobservable = 0;  // poses on frames that are not observable
   int beyond_near = 0, beyond_far = 0;
@@ -69,6 +72,7 @@ struct DriveMetrics {
   double mean_nees = 0.0;
   double median_sigma_m = 0.0, median_error_m = 0.0;
   double sigma_x_p50_m = 0.0, sigma_x_p90_m = 0.0, sigma_heading_p50_deg = 0.0;
+  double protection_p50_m = 0.0, protection_p90_m = 0.0;  // over the frames with a covariance
 
   double Availability() const;          // observable frames with a pose / observable frames
   double TrackingAvailability() const;  // ... with a `tracking` pose

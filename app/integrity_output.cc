@@ -124,6 +124,36 @@ void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags) {
                   "one word for both or INTRINSICS,MOUNT (default estimate)");
 }
 
+CoastOptions CoastFlags::Options() const {
+  const std::vector<double> bound = ParseNumberList(
+      odometry_bound, 3, "--odometry-bound", "DISTANCE_SHARE,DEGREES_PER_METRE,TURN_SHARE");
+  CheckRange(bound[0], 0.0, 0.99, "--odometry-bound (share of the distance driven)");
+  CheckRange(bound[1], 0.0, 180.0, "--odometry-bound (degrees per metre)");
+  CheckRange(bound[2], 0.0, 0.99, "--odometry-bound (share of the heading turned)");
+  const std::vector<double> limit =
+      ParseNumberList(coast_limit, 2, "--coast-limit", "METRES,FRAMES");
+  CheckRange(limit[0], 0.0, 1000.0, "--coast-limit (metres)");
+  CheckRange(limit[1], 0.0, 1e6, "--coast-limit (frames)");
+  CoastOptions options;
+  options.bound = {bound[0], DegToRad(bound[1]), bound[2]};
+  options.max_distance_m = limit[0];
+  options.max_frames = static_cast<int>(std::lround(limit[1]));
+  options.enabled = options.max_frames > 0;
+  return options;
+}
+
+void AddCoastFlags(CLI::App* cmd, CoastFlags* flags) {
+  cmd->add_option("--odometry-bound", flags->odometry_bound,
+                  "The odometry's stated error bound DISTANCE_SHARE,DEGREES_PER_METRE,TURN_SHARE "
+                  "per step: the frames without an image pose coast on the odometry, their "
+                  "protection levels grown by it (docs/integrity.md)")
+      ->capture_default_str();
+  cmd->add_option("--coast-limit", flags->coast_limit,
+                  "Coasting limit METRES,FRAMES since the last image fix, beyond which the pose "
+                  "is lost (0 frames: no coasting)")
+      ->capture_default_str();
+}
+
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags) {
   cmd->add_flag("--all-poses", flags->all_poses,
                 "poses.txt: every pose (degraded ones too), not only those 'tracking'");

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tracking/integrity/integrity_monitor.h"
+#include "tracking/tracker/odometry_coast.h"
 
 namespace linetrack::app {
 
@@ -35,6 +36,18 @@ struct IntegrityFlags {
 // --held-parameters to `cmd`; AddAllPosesFlag --all-poses.
 void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags);
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags);
+
+// Coasting on the odometry (replay, live): the odometry's stated error bound and the limits.
+struct CoastFlags {
+  std::string odometry_bound = "0.15,3,0.15";  // share of distance, degrees per metre, turn share
+  std::string coast_limit = "2,50";            // metres, frames since the last image fix
+
+  // The options they set. Throws InputError naming the flag when malformed.
+  CoastOptions Options() const;
+};
+
+// Adds --odometry-bound and --coast-limit to `cmd`.
+void AddCoastFlags(CLI::App* cmd, CoastFlags* flags);
 
 // The pose's integrity for JSON: status, reason, sigmas, protection levels and the 6 x 6
 // covariance of the world twist (null without one).

@@ -241,7 +241,7 @@ std::optional<cv::Mat> DrawErrorPlot(const std::vector<ReplayFrameRecord>& recor
 
 nlohmann::ordered_json ReplaySummary(const std::vector<ReplayFrameRecord>& records,
                                      const ReplayRunInfo& info) {
-  int counts[4] = {0, 0, 0, 0};
+  int counts[5] = {0, 0, 0, 0, 0};
   int with_pose = 0;
   std::vector<double> step, decode, translation, rotation;
   for (const ReplayFrameRecord& r : records) {
@@ -271,7 +271,8 @@ nlohmann::ordered_json ReplaySummary(const std::vector<ReplayFrameRecord>& recor
        {{"initialising", counts[static_cast<int>(TrackStatus::kInitialising)]},
         {"tracking", counts[static_cast<int>(TrackStatus::kTracking)]},
         {"lost", counts[static_cast<int>(TrackStatus::kLost)]},
-        {"relocalised", counts[static_cast<int>(TrackStatus::kRelocalised)]}}},
+        {"relocalised", counts[static_cast<int>(TrackStatus::kRelocalised)]},
+        {"coasting", counts[static_cast<int>(TrackStatus::kCoasting)]}}},
       {"losses", info.losses},
       {"recoveries", info.recoveries},
       {"timing_ms", {{"step", Percentiles(step)}, {"decode", Percentiles(decode)}}},

@@ -257,6 +257,7 @@ int RunBenchDrive(const BenchDriveOptions& opt) {
                     {"observable", m.observable},
                     {"availability", m.Availability()},
                     {"tracking_availability", m.TrackingAvailability()},
+                    {"observable_tracking_coasted", m.observable_tracking_coasted},
                     {"poses", m.poses},
                     {"beyond_near", m.beyond_near},
                     {"beyond_far", m.beyond_far},

@@ -52,6 +52,7 @@ struct LiveCommandOptions {
   double max_rate_deg = 57.29577951308232;  // 1 rad/s
   double camera_fps = 0.0;
   IntegrityFlags integrity;
+  CoastFlags coast;
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -219,6 +220,7 @@ class LiveFiles {
     }
     inputs_.tracker.matcher.noise = DetectedLineNoise();
     inputs_.tracker.sequence.integrity = opt.integrity.Options();
+    inputs_.tracker.sequence.coast = opt.coast.Options();
     if (!opt.settings.empty()) inputs_.tracker.settings = ReadTrackerSettings(opt.settings);
     if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
         plan.sim_camera.render_options.scene.clutter > 0) {
@@ -438,6 +440,7 @@ void AddLive(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
   AddIntegrityFlags(cmd, &opt->integrity);
   AddAllPosesFlag(cmd, &opt->integrity);
+  AddCoastFlags(cmd, &opt->coast);
   cmd->add_option("--camera-fps", opt->camera_fps,
                   "Aravis cameras: frame rate to set (frames/s; 0: keep the camera's)");
   cmd->callback([opt, action, cmd] {

@@ -51,6 +51,7 @@ struct ReplayOptions {
   bool overlay_png = false, no_overlay = false, scanline = false;
   LineFlags lines;             // the line extractor of the re-localisation
   IntegrityFlags integrity;    // the alert limit and the sigmas of the pose integrity
+  CoastFlags coast;            // the odometry's bound and the coasting limits
   RecordingOptions recording;  // a rosbag input (--image-topic ...)
   RecordingOpener open_recording;
 };
@@ -271,6 +272,7 @@ class ReplayTracking {
     options.relocalization.initial = SearchBounds{opt.delta_t, DegToRad(opt.delta_phi_deg)};
     options.settings = s.settings;
     options.sequence.integrity = opt.integrity.Options();
+    options.sequence.coast = opt.coast.Options();
     TrackingEngineModel model{opt.model, nullptr, nullptr, nullptr};
     if (s.robot) {
       model = {opt.model, loaded_.model.get(), loaded_.regions.get(), loaded_.area.get()};
@@ -544,6 +546,7 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   AddIntegrityFlags(cmd, &opt->integrity);
   AddAllPosesFlag(cmd, &opt->integrity);
+  AddCoastFlags(cmd, &opt->coast);
   RecordingOptions& bag = opt->recording;
   cmd->add_option("--image-topic", bag.image_topic, "Bag: sensor_msgs/Image topic");
   cmd->add_option("--odom-topic", bag.odom_topic, "Bag: nav_msgs/Odometry topic (the prior)");

@@ -97,6 +97,31 @@ TEST(DriveMetrics, CountsAgainstTheTruth) {
             std::string::npos);
 }
 
+// Coasted poses (source `odometry`): counted apart among the `tracking` ones, and no recovery
+// after a blackout: frames 2-3 covered, 4-5 coasted within bounds, 6 an image pose.
+TEST(DriveMetrics, CoastedPosesAreCountedApartAndAreNoRecovery) {
+  std::vector<FrameTruth> truth;
+  for (long k = 0; k < 7; ++k)
+    truth.push_back(Truth(k, k < 2 || k > 3, k == 2 || k == 3));
+  std::vector<ReplayedFrame> replayed;
+  for (long k = 0; k < 7; ++k) {
+    replayed.push_back(Replayed(k, "tracking", 4.0, 0.01, 0.1));
+    replayed.back().source = k >= 2 && k <= 5 ? "odometry" : "tracker";
+  }
+  const DriveMetrics m = ComputeDriveMetrics(truth, replayed, 50.0);
+  EXPECT_EQ(m.observable, 5);
+  EXPECT_EQ(m.observable_tracking, 5);
+  EXPECT_EQ(m.observable_tracking_coasted, 2);  // frames 4, 5
+  ASSERT_EQ(m.recoveries.size(), 1u);
+  EXPECT_EQ(m.recoveries[0].first_observable, 4);
+  EXPECT_EQ(m.recoveries[0].recovered, 6);
+  EXPECT_EQ(m.recoveries[0].frames_to_recover, 2);
+  const std::string table = FormatDriveTable({{"coast", m, 2.0}});
+  EXPECT_NE(table.find("| ... of which coasted on the odometry (no image fix) | 40.0 % |"),
+            std::string::npos)
+      << table;
+}
+
 TEST(DriveMetrics, NeverRecoveredAndNoBlackout) {
   std::vector<FrameTruth> truth = {Truth(0, true), Truth(1, false, true), Truth(2, true)};
   const std::vector<ReplayedFrame> replayed = {Replayed(0, "tracking", 1.0, 0.01),
@@ -122,6 +147,7 @@ TEST(ReplayFrames, ReadByColumnName) {
   EXPECT_TRUE(f[0].has_pose);
   EXPECT_NEAR(*f[0].translation_error_m, 0.01234, kTol);
   EXPECT_NEAR(f[0].step_ms, 4.5, kTol);
+  EXPECT_EQ(f[0].source, "matcher");
   EXPECT_FALSE(f[1].has_pose);
   EXPECT_EQ(f[1].status, "lost");
   EXPECT_EQ(f[1].note, "no consistent hypothesis; too few edges");

@@ -15,6 +15,7 @@
 #include "models/render/sequence.h"
 #include "models/view_invariant_regions.h"
 #include "tracking/integrity/consistency.h"
+#include "tracking/integrity/edge_residual.h"
 #include "tracking/live/tracker_estimator.h"
 #include "tracking/tracker/sequence_tracker.h"
 #include "tracking/tracker/tracking_engine.h"
@@ -158,12 +159,94 @@ void ExpectLostThenRecovered(const TrackedRun& run) {
   ExpectAccuratePoses(run);
 }
 
+// Without coasting on the odometry (a robot without it).
+SequenceTrackerOptions WithoutCoasting() {
+  SequenceTrackerOptions options;
+  options.coast.enabled = false;
+  return options;
+}
+
 TEST(HallSequence, BlankFramesAreLostAndTheTrackRecovers) {
-  ExpectLostThenRecovered(TrackHall(Hall(), Hide::kBlank));
+  ExpectLostThenRecovered(TrackHall(Hall(), Hide::kBlank, true, WithoutCoasting()));
 }
 
 TEST(HallSequence, OccludedFramesAreLostAndTheTrackRecovers) {
-  ExpectLostThenRecovered(TrackHall(Hall(), Hide::kOccluded));
+  ExpectLostThenRecovered(TrackHall(Hall(), Hide::kOccluded, true, WithoutCoasting()));
+}
+
+// Every pose with finite levels is within them (an integrity failure is a `tracking` one that is
+// not); no `tracking` pose is beyond 10 cm / 2 degrees. Returns the frames `tracking`.
+int ExpectPosesWithinTheirLevels(const TrackedRun& run) {
+  constexpr double kWrongM = 0.10, kWrongDeg = 2.0;
+  int tracking = 0;
+  for (size_t i = 0; i < run.reports.size(); ++i) {
+    const FrameReport& r = run.reports[i];
+    if (!r.cam_from_world) continue;
+    const PoseUncertainty& u = r.uncertainty;
+    const WorldTwist e = WorldTwistBetween(Hall().frames[i].cam_from_world, *r.cam_from_world);
+    if (u.status == IntegrityStatus::kTracking) {
+      ++tracking;
+      EXPECT_LE(e.head<2>().norm(), u.protection_position_m) << "frame " << i << ", " << r.note;
+      EXPECT_LE(std::abs(e[5]), u.protection_rotation_rad) << "frame " << i << ", " << r.note;
+      EXPECT_LE(e.head<2>().norm(), kWrongM) << "frame " << i;
+      EXPECT_LE(RadToDeg(std::abs(e[5])), kWrongDeg) << "frame " << i;
+    }
+  }
+  return tracking;
+}
+
+// The view is blank for 1 s: the odometry (drifting within its stated bound) carries the last
+// pose through, `coasting` with growing levels that hold the truth; the tracker restarts from the
+// coasted pose when the view returns, within kMaxRecoveryFrames.
+TEST(HallSequence, ABlackoutIsCoastedThroughWithNoIntegrityFailure) {
+  const TrackedRun run = TrackHall(Hall(), Hide::kBlank);
+  for (int i = kHiddenFrom; i < kHiddenFrom + kHiddenFrames; ++i) {
+    const FrameReport& r = run.reports[i];
+    EXPECT_EQ(r.status, TrackStatus::kCoasting) << "frame " << i << ": " << r.note;
+    ASSERT_TRUE(r.cam_from_world.has_value()) << "frame " << i;
+    EXPECT_EQ(r.source, "odometry");
+    EXPECT_NE(r.note.find("odometry: "), std::string::npos) << r.note;
+    const WorldTwist e = WorldTwistBetween(Hall().frames[i].cam_from_world, *r.cam_from_world);
+    EXPECT_LE(e.head<2>().norm(), r.uncertainty.protection_position_m) << "frame " << i;
+    EXPECT_LE(std::abs(e[5]), r.uncertainty.protection_rotation_rad) << "frame " << i;
+    if (i > kHiddenFrom) {
+      EXPECT_GT(r.uncertainty.protection_position_m,
+                run.reports[i - 1].uncertainty.protection_position_m)
+          << "frame " << i;
+    }
+  }
+  const int back = kHiddenFrom + kHiddenFrames;
+  int image_fix = -1;
+  for (int i = back; i < kFrames && image_fix < 0; ++i) {
+    if (run.reports[i].status != TrackStatus::kCoasting) image_fix = i;
+  }
+  ASSERT_GE(image_fix, back) << "the tracker never came back on the image";
+  EXPECT_LT(image_fix - back, kMaxRecoveryFrames);
+  EXPECT_GT(ExpectPosesWithinTheirLevels(run), kFrames / 2);
+}
+
+// The odometry slips 0.5 m in one step while the view is clear, far beyond its stated bound: the
+// tracker, started from the odometry's prediction, refuses the frame; the coasted pose is off by
+// the slip, and the next image pose contradicts it: that frame is `degraded` with the reason, no
+// frame in between is `tracking`, and no `tracking` pose of the run is wrong.
+TEST(HallSequence, AnOdometryBeyondItsBoundIsFlaggedAgainstTheImage) {
+  constexpr double kSlipM = 0.5;
+  constexpr double kSlipAllowanceM = 0.1;  // the odometry's own bound on the slipped step
+  const TrackedRun run = TrackHall(Hall(), Hide::kNothing, true, {}, kSlipM);
+  const int slip = kHiddenFrom + kHiddenFrames / 2;
+  int image_fix = -1;  // the first image pose from the slip on
+  for (int i = slip; i < kFrames && image_fix < 0; ++i) {
+    const FrameReport& r = run.reports[i];
+    EXPECT_NE(r.uncertainty.status, IntegrityStatus::kTracking) << "frame " << i << ": " << r.note;
+    if (r.cam_from_world && r.source != "odometry") image_fix = i;
+  }
+  ASSERT_GE(image_fix, slip) << "the tracker never came back on the image";
+  const PoseUncertainty& u = run.reports[image_fix].uncertainty;
+  EXPECT_EQ(u.status, IntegrityStatus::kDegraded);
+  EXPECT_NE(u.reason.find("one of them is faulty"), std::string::npos) << u.reason;
+  // The union of the two bounds spans the slip.
+  EXPECT_GE(u.protection_position_m, kSlipM - kSlipAllowanceM);
+  ExpectPosesWithinTheirLevels(run);
 }
 
 // The start of the loop at 30 frames/s, head level (the frames of the live CLI test): the robot
@@ -184,6 +267,7 @@ TEST(HallSequence, TurningStartAtThirtyFramesPerSecondReportsNoWrongPose) {
   EXPECT_GE(with_pose, kMinFramesWithPose);
   SequenceTrackerOptions ungated;
   ungated.rms_jump_ratio = 1e9;
+  ungated.coast.enabled = false;  // the coasted pose would stand in for the wrong one
   const TrackedRun control = TrackHall(turning, Hide::kNothing, false, ungated);
   double worst_m = 0.0;
   for (size_t i = 0; i < control.reports.size(); ++i) {

@@ -12,6 +12,8 @@ const char* ToString(PoseStatus status) {
       return "lost";
     case PoseStatus::kRelocalised:
       return "relocalised";
+    case PoseStatus::kCoasting:
+      return "coasting";
   }
   return "unknown";
 }

@@ -21,9 +21,10 @@ enum class PoseStatus {
   kTracking,      // a pose, followed from the previous frame (or the first one)
   kLost,          // no pose on this frame after having had one
   kRelocalised,   // a pose found again after a loss
+  kCoasting,      // no image pose: the last pose carried by the odometry
 };
 
-// "initialising", "tracking", "lost", "relocalised".
+// "initialising", "tracking", "lost", "relocalised", "coasting".
 const char* ToString(PoseStatus status);
 
 // What an estimator says about one frame.

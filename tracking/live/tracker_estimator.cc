@@ -12,6 +12,8 @@ PoseStatus PoseStatusOf(TrackStatus status) {
       return PoseStatus::kLost;
     case TrackStatus::kRelocalised:
       return PoseStatus::kRelocalised;
+    case TrackStatus::kCoasting:
+      return PoseStatus::kCoasting;
   }
   return PoseStatus::kLost;
 }

@@ -66,13 +66,10 @@ const char* ToString(TrackStatus status) {
       return "lost";
     case TrackStatus::kRelocalised:
       return "relocalised";
+    case TrackStatus::kCoasting:
+      return "coasting";
   }
   return "unknown";
-}
-
-Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const RobotPose& then,
-                                      const RobotPose& now) {
-  return CamFromWorld(now) * CamFromWorld(then).inverse() * last;
 }
 
 bool SequenceTrackerOptions::Check(std::string* why) const {
@@ -81,7 +78,7 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
   tolerances.tilt = 0.0;
   tolerances.roll = 0.0;
   if (!health.Check(why) || !motion.Check(why) || !tolerances.Check(why)) return false;
-  if (!integrity.Check(why) || !reacquisition.Check(why)) return false;
+  if (!integrity.Check(why) || !reacquisition.Check(why) || !coast.Check(why)) return false;
   if (restart_window < 0) {
     *why = "restart window must be >= 0 frames";
     return false;
@@ -393,8 +390,10 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   undistorted_ = &undistorter_.Apply(image);
   report.undistort_ms = MillisecondsSince(start);
 
+  const std::optional<CoastedPose> coasted = CoastToFrame(robot);
   if (following_) {
     Follow(t, robot, &report);
+    Combine(robot, coasted, &report);
     report.total_ms = MillisecondsSince(start);
     return report;
   }
@@ -409,6 +408,13 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     return true;
   };
   if (start_pose_ && try_candidate(*start_pose_, "start pose")) start_pose_.reset();
+  // The coasted pose is where the last reported pose is now: restart there first.
+  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
+  std::string restart_note;
+  if (!source && options_.restart_from_last_good && coasting &&
+      !try_candidate(coasted->cam_from_world, "restart")) {
+    restart_note = report.note;
+  }
   if (!source && relocalizer_ && robot) {
     RobotPose prior;
     SearchBounds bounds;
@@ -424,13 +430,14 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
       report.note = "no prior for the matcher";
     }
   }
-  if (!source && options_.restart_from_last_good && last_good_ &&
+  if (!source && options_.restart_from_last_good && !coasting && last_good_ &&
       FramesSinceGood() <= options_.restart_window) {
     const std::string matcher_note = report.note;
     if (!try_candidate(last_good_->cam_from_world, "restart") && !matcher_note.empty()) {
       report.note = matcher_note + "; restart: " + report.note;
     }
   }
+  if (!source && !restart_note.empty()) report.note += "; restart: " + restart_note;
   if (!source && !start_pose_ && !(relocalizer_ && robot) && !last_good_) {
     report.note = "no start pose and no prior";
   }
@@ -457,8 +464,79 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     report.cam_from_world.reset();
     report.uncertainty.reason = report.note;
   }
+  Combine(robot, coasted, &report);
   report.total_ms = MillisecondsSince(start);
   return report;
+}
+
+std::optional<CoastedPose> SequenceTracker::CoastToFrame(
+    const std::optional<RobotReading>& robot) const {
+  if (!options_.coast.enabled || !anchor_ || !robot || !robot->odometry) return std::nullopt;
+  return Coast(*anchor_, WithReading(*robot->odometry, *robot), options_.coast, options_.integrity);
+}
+
+void SequenceTracker::Combine(const std::optional<RobotReading>& robot,
+                              const std::optional<CoastedPose>& coasted, FrameReport* report) {
+  if (!options_.coast.enabled || !robot || !robot->odometry) {
+    anchor_.reset();
+    return;
+  }
+  const RobotPose now = WithReading(*robot->odometry, *robot);
+  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
+  PoseUncertainty& u = report->uncertainty;
+  auto report_coasted = [&]() {
+    report->cam_from_world = coasted->cam_from_world;
+    u = coasted->uncertainty;
+    report->source = "odometry";
+    anchor_ = coasted->anchor;
+  };
+  if (!report->cam_from_world) {
+    if (!coasting) {
+      if (coasted) {
+        report->note += (report->note.empty() ? "" : "; ") + coasted->uncertainty.reason;
+        report->uncertainty.reason = report->note;
+      }
+      anchor_.reset();
+      return;
+    }
+    const std::string image = report->note;
+    report_coasted();
+    report->status = TrackStatus::kCoasting;
+    report->note = coasted->note + (image.empty() ? "" : "; image: " + image);
+    return;
+  }
+  // An unconfirmed matcher's pose: its levels are not trusted yet (ReacquisitionCheck).
+  const bool reacquiring = reacquisition_.has_value();
+  if (coasting) {
+    const PoseDisagreement d =
+        Disagreement(*report->cam_from_world, u, coasted->cam_from_world, coasted->uncertainty);
+    if (d.contradicts) {
+      u = UnionOfContradicting(u, coasted->uncertainty, d,
+                               "the image pose is " + Fixed(d.position_m, 2) + " m / " +
+                                   Fixed(RadToDeg(d.rotation_rad), 1) +
+                                   " deg from the pose the odometry carries, beyond both levels (" +
+                                   coasted->note + "): one of them is faulty");
+      anchor_ = AnchorAtFix(*report->cam_from_world, u, now, frame_index_);
+      return;
+    }
+    const bool coasted_tracking = coasted->uncertainty.status == IntegrityStatus::kTracking;
+    if (reacquiring ? coasted_tracking : PreferCoasted(u, coasted->uncertainty)) {
+      report_coasted();
+      report->note = coasted->note + (reacquiring ? " (the matcher's pose agrees, unconfirmed)"
+                                                  : " (the image pose agrees, with larger levels)");
+      return;
+    }
+  }
+  if (reacquiring) {
+    // The coasted pose's bound holds whatever is reported: the chain goes on under it.
+    if (coasting) {
+      anchor_ = coasted->anchor;
+    } else {
+      anchor_.reset();
+    }
+    return;
+  }
+  anchor_ = AnchorAtFix(*report->cam_from_world, u, now, frame_index_);
 }
 
 }  // namespace linetrack

@@ -16,6 +16,7 @@
 #include "tracking/integrity/integrity_monitor.h"
 #include "tracking/tracker/edge_tracker.h"
 #include "tracking/tracker/image_undistorter.h"
+#include "tracking/tracker/odometry_coast.h"
 #include "tracking/tracker/relocalizer.h"
 #include "tracking/tracker/tracking_health.h"
 
@@ -27,9 +28,10 @@ enum class TrackStatus {
   kTracking,      // pose followed from the previous frame, or the first pose (start file, matcher)
   kLost,          // the pose was lost or rejected on this frame and not found again (no pose)
   kRelocalised,   // the pose was found again after a loss (matcher or restart), verified
+  kCoasting,      // no image pose: the last reported pose carried by the odometry
 };
 
-// "initialising", "tracking", "lost", "relocalised".
+// "initialising", "tracking", "lost", "relocalised", "coasting".
 const char* ToString(TrackStatus status);
 
 // What a robot knows at a frame: its camera height and tilt (head encoders) and, with a prior
@@ -65,6 +67,10 @@ struct SequenceTrackerOptions {
   // refinement's edges and points (tracking/integrity/, docs/integrity.md).
   IntegrityOptions integrity;
   ReacquisitionCheck reacquisition;
+  // Coasting on the odometry (with a prior file): the frames without an image pose report the
+  // last pose carried by the odometry, its levels grown by the odometry's stated bound; an image
+  // pose is checked against the coasted one (odometry_coast.h, docs/integrity.md section 5.1).
+  CoastOptions coast;
   HealthThresholds health;
   MotionLimits motion;
   RobotConstraint robot_tolerances;  // its height, tilt and roll are each frame's reading
@@ -97,12 +103,6 @@ struct SequenceTrackerOptions {
   bool Check(std::string* why) const;
 };
 
-// The camera pose now from the last pose and the robot's readings then and now (odometry position
-// and heading, height, tilt, roll): C_now C_then^-1 last, with C = CamFromWorld of a reading.
-// Keeps the last pose's own small errors; only the relative motion of the odometry is used.
-Eigen::Isometry3d PredictFromOdometry(const Eigen::Isometry3d& last, const RobotPose& then,
-                                      const RobotPose& now);
-
 // What happened on one frame.
 struct FrameReport {
   TrackStatus status = TrackStatus::kInitialising;
@@ -114,9 +114,10 @@ struct FrameReport {
   PoseUncertainty uncertainty;
   TrackHealth health;  // of the last tracking on this frame
   bool health_measured = false;
-  std::string source;  // where the pose came from: "tracker", "start pose", "matcher", "restart"
-  std::string note;    // why there is no pose (empty otherwise)
-  int lines = -1;      // segments extracted when the matcher ran, else -1
+  // Where the pose came from: "tracker", "start pose", "matcher", "restart", "odometry" (coasted).
+  std::string source;
+  std::string note;        // why there is no pose (empty otherwise)
+  int lines = -1;          // segments extracted when the matcher ran, else -1
   bool predicted = false;  // tracking started from the odometry's prediction
   double undistort_ms = 0.0;
   double track_ms = 0.0;       // tracking from the previous frame, of which:
@@ -188,6 +189,14 @@ class SequenceTracker {
   bool CheckReacquisition(const std::optional<RobotReading>& robot,
                           const std::optional<GoodPose>* started_after, FrameReport* report);
   void Drop(const std::string& why, FrameReport* report);
+  // The last reported pose carried to this frame by the odometry (none without an anchor or
+  // odometry).
+  std::optional<CoastedPose> CoastToFrame(const std::optional<RobotReading>& robot) const;
+  // The image pose checked against the coasted one (a contradiction degrades it), or the coasted
+  // pose reported when there is no image pose or it bounds the pose better; then the anchor the
+  // next frame coasts from.
+  void Combine(const std::optional<RobotReading>& robot, const std::optional<CoastedPose>& coasted,
+               FrameReport* report);
 
   // A matcher's pose being confirmed: the pose and the robot's reading at that frame, the frames
   // tracked since, and the good pose before it (restored when the check fails).
@@ -214,7 +223,8 @@ class SequenceTracker {
   std::optional<GoodPose> last_good_;
   std::optional<Reacquisition> reacquisition_;
   std::optional<Pose3Dof> last_odometry_;
-  double driven_m_ = 0.0;  // odometry distance driven since the first frame
+  std::optional<CoastAnchor> anchor_;  // the last reported pose with finite levels
+  double driven_m_ = 0.0;              // odometry distance driven since the first frame
   std::vector<EdgeObservation> verified_observations_;  // of the last StartAndVerify
   std::deque<double> recent_projection_errors_;         // of the last good frames
   std::deque<double> recent_refined_rms_;  // refinement residuals of the last good frames
