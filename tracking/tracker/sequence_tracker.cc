@@ -81,7 +81,7 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
   tolerances.tilt = 0.0;
   tolerances.roll = 0.0;
   if (!health.Check(why) || !motion.Check(why) || !tolerances.Check(why)) return false;
-  if (!integrity.Check(why) || !reacquisition.Check(why)) return false;
+  if (!integrity.Check(why) || !reacquisition.Check(why) || !global.Check(why)) return false;
   if (restart_window < 0) {
     *why = "restart window must be >= 0 frames";
     return false;
@@ -166,6 +166,8 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
                              const std::optional<RobotReading>& robot, const char* source,
                              FrameReport* report) {
   following_ = true;
+  ever_good_ = true;
+  failed_searches_ = 0;
   last_good_ = GoodPose{result.cam_from_world, t, robot, driven_m_};
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
@@ -238,6 +240,7 @@ bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robo
     r.robot = robot;
     r.driven_at_start_m = driven_m_;
     if (started_after) r.before = *started_after;
+    r.global = global_mode_;
     const GoodPose* before = r.before ? &*r.before : nullptr;
     if (before && odometry && before->robot && before->robot->odometry) {
       const Eigen::Vector2d d =
@@ -298,6 +301,11 @@ void SequenceTracker::Drop(const std::string& why, FrameReport* report) {
   if (reacquisition_ && reacquisition_->before) {
     last_good_ = reacquisition_->before;
     last_good_index_ = frame_index_;
+  }
+  // A global pose that fails its confirmation leaves nothing to search around: global again.
+  if (reacquisition_ && reacquisition_->global) {
+    global_mode_ = true;
+    last_good_.reset();
   }
   reacquisition_.reset();
   report->status = TrackStatus::kLost;
@@ -378,6 +386,95 @@ void SequenceTracker::Follow(double t, const std::optional<RobotReading>& robot,
   if (reacquisition_ && !CheckReacquisition(robot, nullptr, report)) Drop(report->note, report);
 }
 
+void SequenceTracker::RequestGlobal() {
+  following_ = false;
+  start_pose_.reset();
+  initial_prior_.reset();
+  last_good_.reset();
+  reacquisition_.reset();
+  recent_projection_errors_.clear();
+  recent_refined_rms_.clear();
+  global_mode_ = true;
+  global_reason_ = "asked";
+  failed_searches_ = 0;
+}
+
+void SequenceTracker::MaybeSwitchToGlobal(const RobotReading& robot) {
+  if (global_mode_) return;
+  LossState state;
+  RobotPose prior;
+  SearchBounds bounds;
+  state.has_prior = relocalizer_ && MatcherPrior(robot, &prior, &bounds);
+  state.frames_since_good = last_good_ ? FramesSinceGood() : static_cast<int>(frame_index_ + 1);
+  state.failed_searches = failed_searches_;
+  if (robot.odometry) state.driven_since_m = driven_m_ - (last_good_ ? last_good_->driven_m : 0.0);
+  const std::string why = GlobalModeReason(state, options_.global);
+  if (why.empty()) return;
+  // The old pose and its statistics say nothing of where the robot is now.
+  global_mode_ = true;
+  global_reason_ = why;
+  failed_searches_ = 0;
+  last_good_.reset();
+  reacquisition_.reset();
+  recent_projection_errors_.clear();
+  recent_refined_rms_.clear();
+}
+
+bool SequenceTracker::TryGlobal(double t, const RobotReading& robot, FrameReport* report) {
+  report->source = "global";
+  const GlobalAttempt attempt = global_->Attempt(*undistorted_, robot.height, robot.tilt);
+  report->lines = attempt.lines;
+  const std::string mode = "global mode (" + global_reason_ + "): ";
+  if (!attempt.found) {
+    report->note = mode + attempt.reason;
+    return false;
+  }
+  if (!StartAndVerify(attempt.cam_from_world, t, robot, report)) {
+    report->note = mode + "its pose is not confirmed by the edges: " + report->note;
+    return false;
+  }
+  return true;
+}
+
+const char* SequenceTracker::Search(double t, const std::optional<RobotReading>& robot,
+                                    FrameReport* report) {
+  if (start_pose_ && StartAndVerify(*start_pose_, t, robot, report)) {
+    start_pose_.reset();
+    global_mode_ = false;
+    return "start pose";
+  }
+  if (global_ && robot) {
+    MaybeSwitchToGlobal(*robot);
+    if (global_mode_) return TryGlobal(t, *robot, report) ? "global" : nullptr;
+  }
+  if (relocalizer_ && robot) {
+    RobotPose prior;
+    SearchBounds bounds;
+    if (MatcherPrior(*robot, &prior, &bounds)) {
+      const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
+      report->lines = attempt.lines;
+      if (!attempt.found) {
+        report->note = attempt.reason;
+      } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
+        return "matcher";
+      }
+    } else {
+      report->note = "no prior for the matcher";
+    }
+  }
+  if (options_.restart_from_last_good && last_good_ &&
+      FramesSinceGood() <= options_.restart_window) {
+    const std::string matcher_note = report->note;
+    if (StartAndVerify(last_good_->cam_from_world, t, robot, report)) return "restart";
+    if (!matcher_note.empty()) report->note = matcher_note + "; restart: " + report->note;
+  }
+  if (!start_pose_ && !(relocalizer_ && robot) && !last_good_) {
+    report->note = "no start pose and no prior";
+  }
+  if (report->lines >= options_.global.kidnap_min_lines) ++failed_searches_;
+  return nullptr;
+}
+
 FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double t,
                                      const std::optional<RobotReading>& robot) {
   const Clock::time_point start = Clock::now();
@@ -401,39 +498,8 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
 
   // Not following: find the pose (again). Candidates in order; each is verified by tracking.
   const Clock::time_point search_start = Clock::now();
-  const bool had_pose = last_good_.has_value();
-  const char* source = nullptr;
-  auto try_candidate = [&](const Eigen::Isometry3d& candidate, const char* name) {
-    if (!StartAndVerify(candidate, t, robot, &report)) return false;
-    source = name;
-    return true;
-  };
-  if (start_pose_ && try_candidate(*start_pose_, "start pose")) start_pose_.reset();
-  if (!source && relocalizer_ && robot) {
-    RobotPose prior;
-    SearchBounds bounds;
-    if (MatcherPrior(*robot, &prior, &bounds)) {
-      const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
-      report.lines = attempt.lines;
-      if (!attempt.found) {
-        report.note = attempt.reason;
-      } else {
-        try_candidate(attempt.cam_from_world, "matcher");
-      }
-    } else {
-      report.note = "no prior for the matcher";
-    }
-  }
-  if (!source && options_.restart_from_last_good && last_good_ &&
-      FramesSinceGood() <= options_.restart_window) {
-    const std::string matcher_note = report.note;
-    if (!try_candidate(last_good_->cam_from_world, "restart") && !matcher_note.empty()) {
-      report.note = matcher_note + "; restart: " + report.note;
-    }
-  }
-  if (!source && !start_pose_ && !(relocalizer_ && robot) && !last_good_) {
-    report.note = "no start pose and no prior";
-  }
+  const bool had_pose = ever_good_;
+  const char* source = Search(t, robot, &report);
   report.relocalize_ms = MillisecondsSince(search_start);
   if (source) {
     const Eigen::Isometry3d pose = *report.cam_from_world;
@@ -447,11 +513,19 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     report.status = had_pose ? TrackStatus::kRelocalised : TrackStatus::kTracking;
     if (had_pose) ++recoveries_;
     Assess(verified_observations_, robot, &report);
-    const bool matcher = std::string(source) == "matcher";
+    // A global pose has no pose before it: its check starts afresh, against nothing.
+    const bool global = std::string(source) == "global";
+    if (global) before.reset();
+    const bool matcher = global || std::string(source) == "matcher";
     if ((matcher || reacquisition_) &&
         !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
       Drop(report.note, &report);
     }
+    if (global && report.cam_from_world) {
+      report.uncertainty.reason =
+          "global mode (" + global_reason_ + "); " + report.uncertainty.reason;
+    }
+    if (global) global_mode_ = false;
   } else {
     report.status = had_pose ? TrackStatus::kLost : TrackStatus::kInitialising;
     report.cam_from_world.reset();
