@@ -13,6 +13,10 @@ bool GlobalRecoveryOptions::Check(std::string* why) const {
     *why = "global mode: frames before the switch must be >= 0 (0: off)";
     return false;
   }
+  if (!(rival_distance_m > 0.0) || !(rival_heading_deg > 0.0)) {
+    *why = "global mode: the rival distance and heading must be > 0";
+    return false;
+  }
   if (!(lost_distance_m >= 0.0)) {
     *why = "global mode: the distance must be >= 0 metres (0: off)";
     return false;

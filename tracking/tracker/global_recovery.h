@@ -20,15 +20,23 @@ namespace linetrack {
 struct GlobalRecoveryOptions {
   // The engine builds the global mode (for these triggers and SequenceTracker::RequestGlobal).
   bool enabled = true;
-  // kidnap_frames searches in a row around the carried prior found nothing on frames with at
-  // least kidnap_min_lines segments: the view disagrees with the prior, the robot was carried
-  // away (the odometry does not see the carry, so it cannot tell).
+  // kidnap_frames matcher searches in a row around the carried prior found no consistent
+  // hypothesis on frames with at least kidnap_min_lines segments: the view disagrees with the
+  // prior, the robot was carried away (the odometry does not see the carry, so it cannot tell).
+  // A blank frame leaves the count as it is; a pose found near the prior resets it.
   int kidnap_frames = 3;
   int kidnap_min_lines = 8;
   // Lost for lost_frames frames (the relocaliser's widening bounds reach their limit after 24
   // frames by default) or lost_distance_m metres driven since the last good pose.
   int lost_frames = 25;
   double lost_distance_m = 3.0;
+  // A re-localisation by the matcher near the carried prior is checked by the global mode: an
+  // ambiguous answer, or a pose farther than rival_distance_m or rival_heading_deg from the
+  // matcher's, means the view repeats elsewhere (a carried robot may stand in the twin of the
+  // corridor it left): the matcher's pose is withheld and the global mode takes over.
+  bool check_relocalisations = true;
+  double rival_distance_m = 0.5;
+  double rival_heading_deg = 10.0;
 
   bool Check(std::string* why) const;
 };
@@ -37,7 +45,7 @@ struct GlobalRecoveryOptions {
 struct LossState {
   bool has_prior = false;        // there is a prior for the matcher (a good pose, odometry, ...)
   int frames_since_good = 0;     // frames since the last good pose
-  int failed_searches = 0;       // searches in a row that found nothing on frames with lines
+  int failed_searches = 0;       // matcher searches in a row that found nothing, frames with lines
   double driven_since_m = -1.0;  // odometry distance since the last good pose; < 0: no odometry
 };
 

@@ -386,17 +386,44 @@ void SequenceTracker::Follow(double t, const std::optional<RobotReading>& robot,
   if (reacquisition_ && !CheckReacquisition(robot, nullptr, report)) Drop(report->note, report);
 }
 
-void SequenceTracker::RequestGlobal() {
+void SequenceTracker::EnterGlobalMode(const std::string& why) {
   following_ = false;
-  start_pose_.reset();
-  initial_prior_.reset();
   last_good_.reset();
   reacquisition_.reset();
   recent_projection_errors_.clear();
   recent_refined_rms_.clear();
   global_mode_ = true;
-  global_reason_ = "asked";
+  global_reason_ = why;
   failed_searches_ = 0;
+}
+
+void SequenceTracker::RequestGlobal() {
+  start_pose_.reset();
+  initial_prior_.reset();
+  EnterGlobalMode("asked");
+}
+
+bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot,
+                               FrameReport* report) {
+  const GlobalRecoveryOptions& o = options_.global;
+  if (!global_ || !o.check_relocalisations || !ever_good_) return false;
+  const GlobalAttempt g = global_->Attempt(*undistorted_, robot.height, robot.tilt);
+  std::string rival;
+  if (g.ambiguous) {
+    rival = "the global mode finds the view ambiguous (" + std::to_string(g.rivals) + " rivals)";
+  } else if (g.found) {
+    const Eigen::Vector2d d = PlanarDifference(PlanarOf(g.cam_from_world), PlanarOf(pose));
+    if (d[0] > o.rival_distance_m || d[1] > DegToRad(o.rival_heading_deg)) {
+      rival = "the global mode finds a pose " + Fixed(d[0], 2) + " m / " +
+              Fixed(RadToDeg(d[1]), 1) + " deg away";
+    }
+  }
+  if (rival.empty()) return false;
+  EnterGlobalMode("the matcher's pose near the prior has a rival: " + rival);
+  report->cam_from_world.reset();
+  report->source = "global";
+  report->note = "global mode (" + global_reason_ + ")";
+  return true;
 }
 
 void SequenceTracker::MaybeSwitchToGlobal(const RobotReading& robot) {
@@ -411,13 +438,7 @@ void SequenceTracker::MaybeSwitchToGlobal(const RobotReading& robot) {
   const std::string why = GlobalModeReason(state, options_.global);
   if (why.empty()) return;
   // The old pose and its statistics say nothing of where the robot is now.
-  global_mode_ = true;
-  global_reason_ = why;
-  failed_searches_ = 0;
-  last_good_.reset();
-  reacquisition_.reset();
-  recent_projection_errors_.clear();
-  recent_refined_rms_.clear();
+  EnterGlobalMode(why);
 }
 
 bool SequenceTracker::TryGlobal(double t, const RobotReading& robot, FrameReport* report) {
@@ -453,10 +474,17 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
     if (MatcherPrior(*robot, &prior, &bounds)) {
       const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
       report->lines = attempt.lines;
+      // The frame disagrees with the prior only when the matcher finds nothing around it; a pose
+      // found there that the edges do not hold says the prior still fits.
+      if (attempt.found) {
+        failed_searches_ = 0;
+      } else if (attempt.lines >= options_.global.kidnap_min_lines) {
+        ++failed_searches_;
+      }
       if (!attempt.found) {
         report->note = attempt.reason;
       } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
-        return "matcher";
+        return HasRival(attempt.cam_from_world, *robot, report) ? nullptr : "matcher";
       }
     } else {
       report->note = "no prior for the matcher";
@@ -471,7 +499,6 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
   if (!start_pose_ && !(relocalizer_ && robot) && !last_good_) {
     report->note = "no start pose and no prior";
   }
-  if (report->lines >= options_.global.kidnap_min_lines) ++failed_searches_;
   return nullptr;
 }
 
@@ -517,15 +544,19 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     const bool global = std::string(source) == "global";
     if (global) before.reset();
     const bool matcher = global || std::string(source) == "matcher";
-    if ((matcher || reacquisition_) &&
-        !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
+    if (global && !report.cam_from_world) {
+      // The integrity monitor finds the global pose lost: nothing to confirm, search again.
+      following_ = false;
+      last_good_.reset();
+    } else if ((matcher || reacquisition_) &&
+               !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
       Drop(report.note, &report);
     }
     if (global && report.cam_from_world) {
       report.uncertainty.reason =
           "global mode (" + global_reason_ + "); " + report.uncertainty.reason;
+      global_mode_ = false;
     }
-    if (global) global_mode_ = false;
   } else {
     report.status = had_pose ? TrackStatus::kLost : TrackStatus::kInitialising;
     report.cam_from_world.reset();

@@ -191,6 +191,12 @@ class SequenceTracker {
   const char* Search(double t, const std::optional<RobotReading>& robot, FrameReport* report);
   // Switches to the global mode when the loss calls for it (GlobalModeReason).
   void MaybeSwitchToGlobal(const RobotReading& robot);
+  // Enters the global mode: the old pose, its reacquisition and jump statistics are dropped.
+  void EnterGlobalMode(const std::string& why);
+  // After a loss, the global mode's answer on the frame against the matcher's `pose`
+  // (GlobalRecoveryOptions::check_relocalisations): true (and the global mode entered) when it
+  // has a rival elsewhere or is ambiguous.
+  bool HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot, FrameReport* report);
   // Localises the frame with the global mode and verifies its pose; false when none.
   bool TryGlobal(double t, const RobotReading& robot, FrameReport* report);
   // With odometry now and at the last frame: restarts the tracker from the predicted pose when
@@ -244,7 +250,7 @@ class SequenceTracker {
   bool following_ = false;                 // the tracker holds a good pose from the previous frame
   bool ever_good_ = false;                 // a pose was accepted on some frame
   bool global_mode_ = false;               // lost frames are localised by the global mode
-  int failed_searches_ = 0;    // searches in a row that found nothing on frames with lines
+  int failed_searches_ = 0;    // matcher searches in a row finding nothing (GlobalRecoveryOptions)
   std::string global_reason_;  // why the global mode was entered
   long frame_index_ = -1;      // frames processed - 1
   long last_good_index_ = -1;
