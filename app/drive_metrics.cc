@@ -73,6 +73,18 @@ std::string RecoveryText(const DriveMetrics& m) {
   return out;
 }
 
+std::string KidnapText(const DriveMetrics& m) {
+  if (m.kidnaps.empty()) return "no kidnap";
+  std::string out;
+  int wrong = 0;
+  for (const KidnapRecovery& k : m.kidnaps) {
+    if (!out.empty()) out += ", ";
+    out += k.frames_to_recover >= 0 ? std::to_string(k.frames_to_recover) : "never";
+    wrong += k.wrong_tracking;
+  }
+  return out + " (" + std::to_string(wrong) + " wrong `tracking` poses meanwhile)";
+}
+
 }  // namespace
 
 std::vector<ReplayedFrame> ParseReplayFrames(const std::string& text, const std::string& source) {
@@ -247,6 +259,8 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
   });
   row("frames to recover after each blackout",
       [](const DriveMetrics& m, const auto&) { return RecoveryText(m); });
+  row("frames to recover after each kidnap (to a `tracking` pose)",
+      [](const DriveMetrics& m, const auto&) { return KidnapText(m); });
   row("replay fps: tracking frames / overall", [](const DriveMetrics& m, const auto&) {
     return Fixed(m.tracking_fps, 0) + " / " + Fixed(m.overall_fps, 0);
   });
@@ -300,6 +314,36 @@ std::string FormatDriveTable(const std::vector<DriveReport>& reports,
     out += "\n";
   }
   return out;
+}
+
+void AddKidnapRecoveries(const std::vector<FrameTruth>& truth,
+                         const std::vector<ReplayedFrame>& replayed,
+                         const std::vector<long>& kidnap_frames, const DriveMetricsOptions& options,
+                         DriveMetrics* m) {
+  std::map<long, const ReplayedFrame*> replay_of;
+  for (const ReplayedFrame& f : replayed)
+    replay_of[f.frame] = &f;
+  for (size_t k = 0; k < kidnap_frames.size(); ++k) {
+    KidnapRecovery r;
+    r.frame = kidnap_frames[k];
+    const long next = k + 1 < kidnap_frames.size() ? kidnap_frames[k + 1] : -1;
+    for (const FrameTruth& t : truth) {
+      if (t.frame < r.frame) continue;
+      if (next >= 0 && t.frame >= next) break;
+      const auto it = replay_of.find(t.frame);
+      const ReplayedFrame* f = it != replay_of.end() ? it->second : nullptr;
+      const bool tracking = f && f->has_pose && f->status == "tracking";
+      const bool near = tracking && !Beyond(*f, options.near_m, options.near_deg);
+      r.wrong_tracking += tracking && !near;
+      if (r.first_observable < 0 && t.observable) r.first_observable = t.frame;
+      if (r.first_observable >= 0 && near) {
+        r.recovered = t.frame;
+        r.frames_to_recover = static_cast<int>(t.frame - r.first_observable);
+        break;
+      }
+    }
+    m->kidnaps.push_back(r);
+  }
 }
 
 void AddIntegrityFigures(const nlohmann::json& integrity, DriveMetrics* m) {

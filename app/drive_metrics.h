@@ -48,6 +48,16 @@ struct BlackoutRecovery {
   int frames_to_recover = -1;  // recovered - first_observable; -1 when never
 };
 
+// The frames from a kidnap's put-down until a `tracking` pose within the near bounds.
+struct KidnapRecovery {
+  long frame = 0;              // the put-down
+  long first_observable = -1;  // the first observable frame from there (-1: none)
+  long recovered = -1;         // from there, the first `tracking` pose within near bounds
+  int frames_to_recover = -1;  // recovered - first_observable; -1 when never
+  int wrong_tracking = 0;      // `tracking` poses beyond the near bounds from the put-down on,
+                               // until recovered (or the next kidnap)
+};
+
 struct DriveMetrics {
   int frames = 0;
   int observable = 0;
@@ -62,9 +72,10 @@ struct DriveMetrics {
   double worst_m = 0.0, worst_deg = 0.0;
   long worst_m_frame = -1, worst_deg_frame = -1;
   std::vector<BlackoutRecovery> recoveries;
-  double tracking_fps = 0.0;         // tracking frames over their summed step time
-  double overall_fps = 0.0;          // the replay's throughput (decoding and every step)
-  std::vector<size_t> worst_frames;  // indexes into the replayed frames, worst first
+  std::vector<KidnapRecovery> kidnaps;  // AddKidnapRecoveries; none: the row says so
+  double tracking_fps = 0.0;            // tracking frames over their summed step time
+  double overall_fps = 0.0;             // the replay's throughput (decoding and every step)
+  std::vector<size_t> worst_frames;     // indexes into the replayed frames, worst first
   // From replay's summary "integrity" (AddIntegrityFigures); n/a without it.
   std::optional<int> integrity_failures;
   std::optional<double> nees_within_99;
@@ -83,6 +94,13 @@ struct DriveMetrics {
 DriveMetrics ComputeDriveMetrics(const std::vector<FrameTruth>& truth,
                                  const std::vector<ReplayedFrame>& replayed, double overall_fps,
                                  const DriveMetricsOptions& options = {});
+
+// The recovery after each kidnap (`kidnap_frames`: the put-down frames of sequence.json's
+// "kidnaps", increasing) into `metrics`.
+void AddKidnapRecoveries(const std::vector<FrameTruth>& truth,
+                         const std::vector<ReplayedFrame>& replayed,
+                         const std::vector<long>& kidnap_frames, const DriveMetricsOptions& options,
+                         DriveMetrics* metrics);
 
 // Reads replay's summary.json "integrity" (with ground truth) into `metrics`: integrity failures,
 // the NEES calibration against chi2(3), the sigma quantiles. Leaves them n/a when absent.

@@ -92,16 +92,26 @@ nlohmann::ordered_json SequenceJson(const RenderedSequence& s, int observable) {
       {"max_percent", 100.0 * s.drift.max_share},
       {"mean_percent", 100.0 * s.drift.mean_share},
       {"whole_run_percent", 100.0 * s.drift.whole_share}};
+  nlohmann::ordered_json kidnaps = nlohmann::ordered_json::array();
+  for (const Kidnap& k : s.kidnaps) {
+    kidnaps.push_back({{"frame", k.frame},
+                       {"put_down", {k.put_down.x, k.put_down.y, RadToDeg(k.put_down.heading)}}});
+  }
   return {{"frames", s.frames.size()},
           {"duration_s", s.frames.empty() ? 0.0 : s.frames.back().t - s.frames.front().t},
           {"observable_frames", observable},
           {"odometry_drift", drift},
+          {"kidnaps", kidnaps},
           {"effects", EffectsJson(s)}};
 }
 
 }  // namespace
 
-void CheckSequenceFlags(const RenderSequenceOptions& o) {
+void CheckSequenceFlags(RenderSequenceOptions* options) {
+  const RenderSequenceOptions& o = *options;
+  options->kidnaps.clear();
+  for (const std::string& text : o.kidnap_texts)
+    options->kidnaps.push_back(ParseKidnap(text));
   CheckRange(o.pan_amplitude_deg, -180.0, 180.0, "--pan-amplitude");
   CheckRange(o.pan_rate_deg, 0.0, 720.0, "--pan-rate");
   CheckRange(o.odometry_drift_percent, 0.0, 40.0, "--odometry-drift");
@@ -137,6 +147,8 @@ RenderedSequence PrepareSequence(const RenderSequenceOptions& opt, const Navigab
   }
   s.priors = SimulateOdometryPriors(s.frames, odometry);
   s.drift = MeasureOdometryDrift(s.frames, s.priors, kDriftWindowM);
+  s.kidnaps = opt.kidnaps;
+  s.frames = ApplyKidnaps(std::move(s.frames), s.kidnaps, opt.trajectory.empty() ? area : nullptr);
   s.effects_options = opt.effects;
   s.effects_options.seed = opt.seed;
   s.effects = PlanDriveEffects(s.frames, s.effects_options, area);

@@ -8,6 +8,7 @@
 
 #include "models/navigable_area.h"
 #include "models/render/drive_effects.h"
+#include "models/render/kidnap.h"
 #include "models/render/scene_renderer.h"
 #include "models/render/sequence.h"
 #include "models/render/waypoint_path.h"
@@ -31,11 +32,13 @@ struct RenderSequenceOptions {
   DriveEffectsOptions effects;  // its seed is `seed`
   double odometry_drift_percent = 0.0;
   bool drift_given = false;  // odometry from OdometryForDrift, else OdometryOptions' defaults
+  std::vector<std::string> kidnap_texts;  // --kidnap FRAME:x,y,heading_deg, repeated
+  std::vector<Kidnap> kidnaps;            // parsed by CheckSequenceFlags
   uint64_t seed = 1;
 };
 
-// Throws InputError naming the flag when a value is out of range.
-void CheckSequenceFlags(const RenderSequenceOptions& options);
+// Throws InputError naming the flag when a value is out of range; parses the kidnaps.
+void CheckSequenceFlags(RenderSequenceOptions* options);
 
 // A sequence ready to render.
 struct RenderedSequence {
@@ -45,11 +48,13 @@ struct RenderedSequence {
   DriveEffectsOptions effects_options;
   OdometryDrift drift;       // measured over 10 m windows
   double drift_asked = 0.0;  // share; 0 when not asked
+  std::vector<Kidnap> kidnaps;
 };
 
-// The frames, priors and effects of the sequence (nothing written). `area` is needed for the
-// hall loop and checks waypoint paths and where people cross (may be null otherwise). Throws
-// InputError on bad files or values.
+// The frames, priors and effects of the sequence (nothing written); with kidnaps, the odometry
+// is simulated from the drive without them (the carried robot's wheels do not turn). `area` is
+// needed for the hall loop and checks waypoint paths and where people cross (may be null
+// otherwise). Throws InputError on bad files or values.
 RenderedSequence PrepareSequence(const RenderSequenceOptions& options, const NavigableArea* area);
 
 // Renders every frame into `out` (frame_%05d.png) and writes groundtruth.txt, priors.csv,

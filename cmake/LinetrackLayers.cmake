@@ -1,6 +1,7 @@
 # The project's parts and what each may depend on, for its #includes and its links alike.
 # Production (the robot's libraries): models <- calibration, matching <- tracking <- app, with
-# heading and views (matching/) beside matching and global (matching/) above the three.
+# heading and views (matching/) beside matching and global (matching/) above the three; tracking
+# sits above all of matching/ (the global mode of a lost robot).
 # Beside them, parts only app/ and tests/ use: render, synth (models/), evaluation (matching/),
 # sim, fake_gige (tracking/); app/bench/ and tests/support/ sit at the top with app/ and tests/.
 # Part P is the folder below and the library linetrack_P. Used at configure time
@@ -22,7 +23,7 @@ set(LINETRACK_DEPS_matching matching models)
 set(LINETRACK_DEPS_heading heading models)
 set(LINETRACK_DEPS_views views models)
 set(LINETRACK_DEPS_global global matching heading views models)
-set(LINETRACK_DEPS_tracking tracking matching models)
+set(LINETRACK_DEPS_tracking tracking matching heading views global models)
 set(LINETRACK_DEPS_import import models)
 set(LINETRACK_DEPS_render render models)
 set(LINETRACK_DEPS_synth synth models)

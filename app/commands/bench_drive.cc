@@ -50,12 +50,20 @@ struct DriveSpec {
   int frames = 0;
 };
 
-// "--key value" pairs of a JSON object of flags (true: the flag alone).
+// "--key value" pairs of a JSON object of flags (true: the flag alone; an array of strings: the
+// flag repeated with each).
 std::vector<std::string> FlagArgs(const nlohmann::json& flags, const fs::path& base,
                                   const std::string& where) {
   if (!flags.is_object()) throw InputError(where + ": expected an object of flags");
   std::vector<std::string> args;
   for (const auto& [key, value] : flags.items()) {
+    if (value.is_array()) {
+      for (const nlohmann::json& item : value) {
+        if (!item.is_string()) throw InputError(where + ": flag '" + key + "': strings expected");
+        args.insert(args.end(), {"--" + key, item.get<std::string>()});
+      }
+      continue;
+    }
     args.push_back("--" + key);
     if (value.is_boolean()) {
       if (!value.get<bool>()) args.pop_back();
@@ -228,6 +236,12 @@ DriveReport ReplayDrive(const DriveSpec& d, const fs::path& dir, const BenchDriv
   report.metrics =
       ComputeDriveMetrics(*truth, *replayed, summary.value("throughput_fps", 0.0), opt.metrics);
   if (summary.contains("integrity")) AddIntegrityFigures(summary["integrity"], &report.metrics);
+  std::vector<long> kidnaps;
+  if (sequence.contains("kidnaps")) {
+    for (const nlohmann::json& k : sequence["kidnaps"])
+      kidnaps.push_back(k.value("frame", 0L));
+  }
+  AddKidnapRecoveries(*truth, *replayed, kidnaps, opt.metrics, &report.metrics);
   report.drift_percent = sequence["odometry_drift"].value("max_percent", 0.0);
   return report;
 }

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/global_mode_flags.h"
 #include "app/integrity_output.h"
 #include "app/live_output.h"
 #include "app/live_session.h"
@@ -53,6 +54,7 @@ struct LiveCommandOptions {
   double camera_fps = 0.0;
   IntegrityFlags integrity;
   CoastFlags coast;
+  GlobalModeFlags global;  // when a lost robot switches to the global mode
 };
 
 // A window showing the overlay of every frame (X11 through ViSP), when a display answers.
@@ -150,6 +152,7 @@ LivePlan CheckFlags(const LiveCommandOptions& opt) {
         "not been tested with; use --estimator truth with the simulator");
   }
   CheckRange(opt.camera_fps, 0.0, 1000.0, "--camera-fps");
+  opt.global.Options();  // the flags checked before any file is read
   plan.camera_fps = opt.camera_fps;
   if (!plan.sim) {
     if (!plan.use_tracker) throw InputError("--estimator truth: only with --source sim");
@@ -221,6 +224,7 @@ class LiveFiles {
     inputs_.tracker.matcher.noise = DetectedLineNoise();
     inputs_.tracker.sequence.integrity = opt.integrity.Options();
     inputs_.tracker.sequence.coast = opt.coast.Options();
+    inputs_.tracker.sequence.global = opt.global.Options();
     if (!opt.settings.empty()) inputs_.tracker.settings = ReadTrackerSettings(opt.settings);
     if (plan.use_tracker || plan.sim_camera.path == SimPath::kLoop ||
         plan.sim_camera.render_options.scene.clutter > 0) {
@@ -439,6 +443,7 @@ void AddLive(CLI::App& cli, CommandAction* action) {
       ->capture_default_str();
   cmd->add_option("--settings", opt->settings, "ViSP tracker XML (<ecm>, <face>)");
   AddIntegrityFlags(cmd, &opt->integrity);
+  AddGlobalModeFlags(cmd, &opt->global);
   AddAllPosesFlag(cmd, &opt->integrity);
   AddCoastFlags(cmd, &opt->coast);
   cmd->add_option("--camera-fps", opt->camera_fps,

@@ -2,7 +2,7 @@
 //   linetrack render --model M.cao --camera C.xml --pose X,Y,HEADING_DEG --height H --tilt DEG
 //                    --out IMG.png [--seed S] [--clutter N] [--noise SIGMA] [--blur SIGMA]
 //   linetrack render --model M.cao --camera C.xml (--trajectory TUM.txt | --path hall-loop|FILE)
-//                    [effects] --out DIR
+//                    [effects] [--kidnap FRAME:x,y,heading_deg ...] --out DIR
 //     -> DIR/frame_%05d.png, groundtruth.txt, priors.csv, camera.xml, frame_truth.csv,
 //        sequence.json
 #include <spdlog/spdlog.h>
@@ -65,6 +65,7 @@ constexpr FlagUse kFlagUses[] = {
     {"--exposure-changes", kSequence},
     {"--shutter", kSequence},
     {"--odometry-drift", kSequence},
+    {"--kidnap", kSequence},
 };
 
 std::string FormName(unsigned form) {
@@ -161,7 +162,7 @@ int RunRender(RenderCommandOptions opt) {
   opt.sequence.tilt_deg = opt.tilt_deg;
   opt.sequence.seed = opt.seed;
   opt.sequence.drift_given = opt.given.count("--odometry-drift") > 0;
-  CheckSequenceFlags(opt.sequence);
+  CheckSequenceFlags(&opt.sequence);
   const RenderOptions render_options = ImageOptions(opt);
 
   const CameraIntrinsics camera = LoadCamera(opt.camera_path);
@@ -234,6 +235,9 @@ void AddSequenceFlags(CLI::App* cmd, RenderSequenceOptions* s) {
   cmd->add_option("--odometry-drift", s->odometry_drift_percent,
                   "Odometry drift (percent of the distance travelled; default: the generic "
                   "noise model)");
+  cmd->add_option("--kidnap", s->kidnap_texts,
+                  "FRAME:x,y,heading_deg: the robot is carried and put down there (the base) on "
+                  "FRAME, its odometry blind to the carry (repeatable)");
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/commands.h"
+#include "app/global_mode_flags.h"
 #include "app/ground_truth.h"
 #include "app/head_mount.h"
 #include "app/integrity_output.h"
@@ -52,6 +53,7 @@ struct ReplayOptions {
   LineFlags lines;             // the line extractor of the re-localisation
   IntegrityFlags integrity;    // the alert limit and the sigmas of the pose integrity
   CoastFlags coast;            // the odometry's bound and the coasting limits
+  GlobalModeFlags global;      // when a lost robot switches to the global mode
   RecordingOptions recording;  // a rosbag input (--image-topic ...)
   RecordingOpener open_recording;
 };
@@ -208,6 +210,7 @@ ReplaySetup Prepare(const ReplayOptions& opt) {
   CheckRange(opt.delta_phi_deg, 0.1, 180.0, "--delta-phi");
   CheckRange(opt.fps, 0.0, 10000.0, "--fps");
   if (opt.max_frames < 0) throw InputError("--frames: must be >= 0");
+  opt.global.Options();  // the flags checked before any file is read
   if (has_prior) s.initial_prior = ParsePrior(opt.prior, "--prior");
   s.robot = has_prior || has_height_tilt || !opt.prior_file.empty();
 
@@ -273,6 +276,7 @@ class ReplayTracking {
     options.settings = s.settings;
     options.sequence.integrity = opt.integrity.Options();
     options.sequence.coast = opt.coast.Options();
+    options.sequence.global = opt.global.Options();
     TrackingEngineModel model{opt.model, nullptr, nullptr, nullptr};
     if (s.robot) {
       model = {opt.model, loaded_.model.get(), loaded_.regions.get(), loaded_.area.get()};
@@ -545,6 +549,7 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
   cmd->add_flag("--no-overlay", opt->no_overlay, "No overlay");
   AddLineFlags(cmd, &opt->lines, /*with_camera=*/false);
   AddIntegrityFlags(cmd, &opt->integrity);
+  AddGlobalModeFlags(cmd, &opt->global);
   AddAllPosesFlag(cmd, &opt->integrity);
   AddCoastFlags(cmd, &opt->coast);
   RecordingOptions& bag = opt->recording;

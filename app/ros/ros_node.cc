@@ -132,6 +132,8 @@ struct RosNode::Impl {
   NewestOnly<PendingImage> pending;
   std::optional<CameraIntrinsics> camera_from_info;
   std::optional<PendingStart> start;
+  bool global_requested = false;  // ~global_localization was called
+  bool global_available = false;  // the tracker has a global mode (or may have: not built yet)
   std::deque<StampedOdometry> odometry;
   bool stop = false;
   RosNodeStats stats;
@@ -164,6 +166,7 @@ void RosNode::Impl::Setup() {
   tracker_options.settings =
       options.settings.empty() ? base : ReadTrackerSettings(options.settings, base);
   tracker_options.sequence.integrity = options.integrity.Options();
+  global_available = tracker_options.sequence.global.enabled;
   mount_source = std::make_unique<CameraMountSource>(options.MountOptions(), nh);
   if (!options.camera.empty()) {
     tracker_options.camera = LoadCamera(options.camera);
@@ -229,14 +232,21 @@ void RosNode::Impl::OnInitialPose(const geometry_msgs::PoseWithCovarianceStamped
   std::lock_guard<std::mutex> lock(mutex);
   start = PendingStart{PlanarOf(ToIsometry(msg->pose.pose)), ToMatrix6(msg->pose.covariance),
                        msg->header.stamp.toSec()};
+  global_requested = false;  // the newest request wins
 }
 
 bool RosNode::Impl::OnGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  ROS_ERROR(
-      "linetrack: global localisation is not offered by the node: the global mode still "
-      "accepts wrong poses (docs/global.md); give the pose on initialpose (RViz's 2D Pose "
-      "Estimate)");
-  return false;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (!global_available) {
+    ROS_ERROR(
+        "linetrack: no global mode (disabled, or the model has no horizontal edges); give the "
+        "pose on initialpose (RViz's 2D Pose Estimate)");
+    return false;
+  }
+  global_requested = true;
+  start.reset();  // the global mode replaces any initial pose not yet applied
+  ROS_INFO("linetrack: global localisation asked: the prior is dropped");
+  return true;
 }
 
 void RosNode::Impl::Diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -271,6 +281,8 @@ bool RosNode::Impl::EnsureTracker() {
   }
   tracker = std::make_unique<RosTracker>(tracker_options);
   occlusion = std::make_unique<OcclusionTester>(tracker->model());
+  std::lock_guard<std::mutex> lock(mutex);
+  global_available = tracker->has_global_mode();
   return true;
 }
 
@@ -333,6 +345,12 @@ void RosNode::Impl::Process(const PendingImage& image, Clock::time_point taken) 
   }
   if (odom) input.odom_base = PlanarOf(*odom);
   ApplyStart();  // after the odometry's wait: the initial pose is anchored to its reading
+  bool global = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::swap(global, global_requested);
+  }
+  if (global && tracker->RequestGlobal()) map_from_odom.reset();
   const TrackedFrame out = tracker->Process(grey, input);
   Publish(out, header, odom);
   const double busy_ms = std::chrono::duration<double, std::milli>(Clock::now() - taken).count();

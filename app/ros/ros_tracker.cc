@@ -59,11 +59,27 @@ RosTracker::RosTracker(const RosTrackerOptions& options)
   tracker_ = std::make_unique<EdgeTracker>(options_.model_path, options_.camera, options_.settings);
   relocalizer_ = std::make_unique<Relocalizer>(
       *localizer_, MakeLineExtractorFunction(options_.lines), options_.relocalization);
+  if (options_.sequence.global.enabled && !loaded_.directions.angles.empty()) {
+    global_localizer_ = std::make_unique<GlobalLocalizer>(*localizer_, loaded_.directions,
+                                                          GlobalOptionsFor(matcher));
+    global_ = std::make_unique<GlobalRecovery>(*global_localizer_,
+                                               MakeLineExtractorFunction(options_.lines),
+                                               options_.relocalization.min_lines);
+  }
   sequence_ = std::make_unique<SequenceTracker>(tracker_.get(), options_.camera, relocalizer_.get(),
                                                 options_.sequence);
+  sequence_->SetGlobalRecovery(global_.get());
 }
 
 RosTracker::~RosTracker() = default;
+
+bool RosTracker::RequestGlobal() {
+  if (!global_) return false;
+  sequence_->RequestGlobal();
+  unanchored_start_.reset();
+  had_pose_ = false;
+  return true;
+}
 
 void RosTracker::Restart(const Pose3Dof& map_base, const std::optional<Pose3Dof>& odom_base,
                          const SearchBounds& bounds) {
@@ -73,6 +89,7 @@ void RosTracker::Restart(const Pose3Dof& map_base, const std::optional<Pose3Dof>
       *localizer_, MakeLineExtractorFunction(options_.lines), relocalization);
   sequence_ = std::make_unique<SequenceTracker>(tracker_.get(), options_.camera, relocalizer_.get(),
                                                 options_.sequence);
+  sequence_->SetGlobalRecovery(global_.get());
   map_from_odom_ = odom_base ? PlanarIsometry(map_base) * PlanarIsometry(*odom_base).inverse()
                              : Eigen::Isometry3d::Identity();
   unanchored_start_.reset();

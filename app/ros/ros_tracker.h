@@ -17,6 +17,7 @@
 #include "matching/lines/line_extractor.h"
 #include "models/camera.h"
 #include "tracking/tracker/edge_tracker.h"
+#include "tracking/tracker/global_recovery.h"
 #include "tracking/tracker/relocalizer.h"
 #include "tracking/tracker/sequence_tracker.h"
 #include "tracking/tracker/tracker_settings.h"
@@ -57,7 +58,7 @@ struct TrackerInput {
 struct TrackedFrame {
   RosStatus status = RosStatus::kRelocalising;
   TrackStatus track_status = TrackStatus::kInitialising;
-  std::string source;  // "tracker", "matcher", "restart", "start pose"
+  std::string source;  // "tracker", "matcher", "restart", "start pose", "global"
   std::string note;    // why there is no pose, or why it is degraded
   std::optional<Eigen::Isometry3d> cam_from_map;
   std::optional<Eigen::Isometry3d> map_from_base;
@@ -80,6 +81,12 @@ class RosTracker {
   void Restart(const Pose3Dof& map_base, const std::optional<Pose3Dof>& odom_base,
                const SearchBounds& bounds);
 
+  // Drops the pose and the prior: the next frames are localised by the global mode (any position
+  // in the navigable area, any heading), each answer confirmed before it is `tracking`. False
+  // (nothing changed) when the model gives no global mode (no horizontal edges).
+  bool RequestGlobal();
+  bool has_global_mode() const { return global_ != nullptr; }
+
   // Tracks one grey image (distorted, of the options' camera).
   TrackedFrame Process(const vpImage<unsigned char>& image, const TrackerInput& input);
 
@@ -97,6 +104,8 @@ class RosTracker {
   CameraIntrinsics undistorted_camera_;
   std::unique_ptr<Localizer> localizer_;
   std::unique_ptr<Relocalizer> relocalizer_;
+  std::unique_ptr<GlobalLocalizer> global_localizer_;
+  std::unique_ptr<GlobalRecovery> global_;
   std::unique_ptr<EdgeTracker> tracker_;
   std::unique_ptr<SequenceTracker> sequence_;
   // The odometry frame's pose in the map at the last Restart(): odometry readings are moved into

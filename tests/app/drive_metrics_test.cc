@@ -136,6 +136,34 @@ TEST(DriveMetrics, NeverRecoveredAndNoBlackout) {
   EXPECT_NE(FormatDriveTable({{"a", m, 0.0}}).find("| no blackout |"), std::string::npos);
 }
 
+// Two kidnaps (put down on frames 3 and 8): after the first, frame 3 is not observable, a
+// `tracking` pose 30 cm off on frame 4 is wrong, a degraded pose on 5 does not count, and a
+// `tracking` pose within bounds on 6 recovers (2 frames after the first observable, 4); the
+// second never recovers.
+TEST(DriveMetrics, FramesToRecoverAfterEachKidnap) {
+  std::vector<FrameTruth> truth;
+  for (long k = 0; k < 10; ++k)
+    truth.push_back(Truth(k, k != 3));
+  const std::vector<ReplayedFrame> replayed = {
+      Replayed(0, "tracking", 1.0, 0.01), Replayed(1, "tracking", 1.0, 0.01),
+      Replayed(2, "tracking", 1.0, 0.01), Replayed(3, "lost", 1.0),
+      Replayed(4, "tracking", 1.0, 0.30), Replayed(5, "degraded", 1.0, 0.01),
+      Replayed(6, "tracking", 1.0, 0.02), Replayed(7, "tracking", 1.0, 0.02),
+      Replayed(8, "lost", 1.0),           Replayed(9, "degraded", 1.0, 0.01)};
+  DriveMetrics m = ComputeDriveMetrics(truth, replayed, 10.0);
+  AddKidnapRecoveries(truth, replayed, {3, 8}, DriveMetricsOptions(), &m);
+  ASSERT_EQ(m.kidnaps.size(), 2u);
+  EXPECT_EQ(m.kidnaps[0].first_observable, 4);
+  EXPECT_EQ(m.kidnaps[0].recovered, 6);
+  EXPECT_EQ(m.kidnaps[0].frames_to_recover, 2);
+  EXPECT_EQ(m.kidnaps[0].wrong_tracking, 1);
+  EXPECT_EQ(m.kidnaps[1].frames_to_recover, -1);
+  EXPECT_EQ(m.kidnaps[1].wrong_tracking, 0);
+  const std::string table = FormatDriveTable({{"drive", m, 1.0}});
+  EXPECT_NE(table.find("| 2, never (1 wrong `tracking` poses meanwhile) |"), std::string::npos)
+      << table;
+}
+
 TEST(ReplayFrames, ReadByColumnName) {
   const std::string text =
       "frame,time,status,projection_error_deg,moving_edges,time_ms,source,passes,"

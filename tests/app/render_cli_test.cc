@@ -119,6 +119,26 @@ TEST_F(RenderCli, WaypointPathWithEffectsWritesTheTruth) {
               1e-9);
 }
 
+// A kidnap: the truth jumps to the put-down pose, the odometry (priors.csv) does not.
+TEST_F(RenderCli, KidnapMovesTheTruthNotTheOdometry) {
+  constexpr double kExactM = 1e-6;
+  constexpr double kOdometryStepM = 0.2;  // 0.5 m/s at 10 frames/s, with noise: well under
+  const fs::path out = dir_ / "kidnap";
+  const test_support::CommandRun run = Render(
+      "--path hall-loop --nav " + kNav + " --frames 6 --kidnap 3:4,3,90 --out " + out.string());
+  ASSERT_EQ(run.code, 0) << run.err;
+  const std::vector<StampedPose> truth = ReadTum((out / "groundtruth.txt").string());
+  const std::vector<PriorRecord> priors = ReadPriors((out / "priors.csv").string());
+  ASSERT_EQ(truth.size(), 6u);
+  EXPECT_NEAR(truth[3].world_from_cam.translation().x(), 4.0, kExactM);
+  EXPECT_NEAR(truth[3].world_from_cam.translation().y(), 3.0, kExactM);
+  EXPECT_GT((truth[3].world_from_cam.translation() - truth[2].world_from_cam.translation()).norm(),
+            1.0);
+  EXPECT_LT(std::hypot(priors[3].pose.x - priors[2].pose.x, priors[3].pose.y - priors[2].pose.y),
+            kOdometryStepM);
+  EXPECT_NE(test_support::ReadAll(out / "sequence.json").find("\"kidnaps\""), std::string::npos);
+}
+
 TEST_F(RenderCli, FlagsThatCannotApplyAreRefused) {
   const std::string png = (dir_ / "x.png").string();
   const std::string seq = (dir_ / "seq").string();
@@ -167,6 +187,15 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLineAndWritesNothing) {
       {"--path hall-loop --nav /nonexistent.json --out " + seq, "/nonexistent.json"},
       {"--trajectory " + bad_tum + " --out " + seq, "bad.txt:2:"},
       {"--trajectory /nonexistent.txt --out " + seq, "/nonexistent.txt"},
+      {"--path hall-loop --nav " + kNav + " --kidnap 5 --out " + seq, "FRAME:x,y,heading_deg"},
+      {"--path hall-loop --nav " + kNav + " --kidnap x:1,2,3 --out " + seq, "not an integer"},
+      {"--path hall-loop --nav " + kNav + " --kidnap 5:1,2 --out " + seq, "three finite"},
+      {"--path hall-loop --nav " + kNav + " --kidnap 5:1,2,3,4 --out " + seq, "three finite"},
+      {"--path hall-loop --nav " + kNav + " --frames 4 --kidnap 9:1,2,3 --out " + seq,
+       "the frame must be in [1, 4)"},
+      {"--path hall-loop --nav " + kNav + " --frames 4 --kidnap 2:-50,2,0 --out " + seq,
+       "leaves the navigable area"},
+      {"--pose 1,2,3 --kidnap 2:1,2,3 --out " + png, "--kidnap does not apply"},
   };
   ExpectBadInput(cases);
   EXPECT_FALSE(fs::exists(png));

@@ -236,6 +236,8 @@ TEST_F(ReplayCli, HeightAndInapplicableFlagsAreBadInput) {
       {castle + " --delta-t 1", "--delta-t"},      // no robot: no matcher to bound
       {castle + " --detector lsd", "--detector"},  // nor to extract lines for
       {castle + " --prior-file p.csv --tilt 3", "--tilt"},
+      {castle + " --kidnap-after -1", "--kidnap-after"},
+      {castle + " --global-after-m nan", "--global-after-m"},
   };
   for (const auto& [args, flag] : bad) {
     const CommandRun run = Linetrack(args);
@@ -259,7 +261,7 @@ TEST_F(ReplayCli, HelpNamesTheOptions) {
   const CommandRun run = Linetrack("replay --help");
   EXPECT_EQ(run.code, 0);
   for (const char* flag : {"--input", "--prior-file", "--init-pose", "--ground-truth",
-                           "--overlay-png", "--settings"}) {
+                           "--overlay-png", "--settings", "--kidnap-after", "--no-global"}) {
     EXPECT_NE(run.out.find(flag), std::string::npos) << flag;
   }
 }

@@ -3,8 +3,9 @@
 // as on a real robot) and an initial pose off the truth as RViz sends it; the poses must come
 // back stamped with the images' stamps, near the truth, with the integrity monitor's covariance:
 // on ~pose only tracking poses, the truth within the 99.9% region of their covariance, the
-// others on ~pose_degraded; map -> odom on /tf; the status must reach "tracking"; global
-// localisation answers with an error; overlays and diagnostics come out. Then the same with the
+// others on ~pose_degraded; map -> odom on /tf; the status must reach "tracking"; overlays and
+// diagnostics come out. ~global_localization with no initial pose: the global mode finds the
+// robot, and the poses are checked alike. Then the same with the
 // head's angles and offset from TF base -> camera (static and dynamic transforms) instead of
 // --height and --tilt, and with them from joint_states and the camera from camera_info.
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -321,10 +322,6 @@ TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
   // initial pose, applied at the first image without a reading, is anchored at the first one.
   const std::vector<ros::Time> stamps =
       node.Drive(hall, map_from_base, odom_from_map, nullptr, /*first_odometry=*/1);
-
-  std_srvs::Empty empty;
-  EXPECT_FALSE(ros::service::call("/linetrack/global_localization", empty))
-      << "global localisation must answer with an error until it exists";
   ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
 
   // Overlays stamped with their images, up to the last, at the camera's size; diagnostics counting
@@ -357,6 +354,30 @@ TEST(RosNode, TracksRenderedFramesWithOdometryAndAnInitialPose) {
 // ahead of and 0.05 m right of the base's origin (static robot_base -> head on /tf_static), panning
 // (head -> camera_optical on /tf at each image's stamp). The base's truth is the rendered camera
 // moved back by that mount, so that a mount taken wrongly (the offset, a stale pan) misses it.
+// ~global_localization drops the prior: with no initial pose (the odometry frame is not the
+// map's), the global mode finds the robot on the first frames, its pose is confirmed before it is
+// tracking, and every pose is checked as with an initial pose.
+TEST(RosNode, GlobalLocalizationFindsTheRobotWithNoInitialPose) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, 0.0);
+  NodeUnderTest node({"--camera", kCameraFile, "--height", std::to_string(kHeight), "--tilt",
+                      std::to_string(kTiltDeg)});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
+  const std::string service = "/linetrack/global_localization";
+  ASSERT_TRUE(ros::service::waitForService(service, ros::Duration(kDeadlineS)));
+  std_srvs::Empty empty;
+  EXPECT_TRUE(ros::service::call(service, empty));
+  const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
+  const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
+  const std::vector<ros::Time> stamps = node.Drive(hall, map_from_base, odom_from_map, nullptr);
+  {
+    std::lock_guard<std::mutex> lock(node.heard.mutex);
+    ASSERT_FALSE(node.heard.statuses.empty());
+    EXPECT_NE(node.heard.statuses[0], "tracking") << "a global pose must be confirmed first";
+  }
+  ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+}
+
 TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
   const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
   // A generous wait for TF to reach each image's stamp: it comes on another connection. The

@@ -59,6 +59,14 @@ RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
   return prior;
 }
 
+std::vector<Segment2> UsableSegments(const std::vector<Segment2>& lines) {
+  std::vector<Segment2> usable;
+  for (const Segment2& line : lines) {
+    if (line.a.allFinite() && line.b.allFinite() && line.Length() >= 1.0) usable.push_back(line);
+  }
+  return usable;
+}
+
 Relocalizer::Relocalizer(const Localizer& localizer, LineExtractorFunction extractor,
                          const RelocalizationOptions& options)
     : localizer_(localizer), extractor_(std::move(extractor)), options_(options) {
@@ -73,11 +81,7 @@ RelocalizationAttempt Relocalizer::Attempt(const vpImage<unsigned char>& undisto
   RelocalizationAttempt attempt;
   auto start = std::chrono::steady_clock::now();
   LocalizationProblem problem;
-  for (const Segment2& line : extractor_(undistorted)) {
-    // The matcher rejects degenerate segments as bad input; an extractor may produce them.
-    if (line.a.allFinite() && line.b.allFinite() && line.Length() >= 1.0)
-      problem.lines.push_back(line);
-  }
+  problem.lines = UsableSegments(extractor_(undistorted));
   attempt.extract_ms = MillisecondsSince(start);
   attempt.lines = static_cast<int>(problem.lines.size());
   if (attempt.lines < options_.min_lines) {

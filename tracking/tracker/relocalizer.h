@@ -46,6 +46,10 @@ SearchBounds WidenedBounds(int frames_since_good, const RelocalizationOptions& o
 RobotPose CarryPrior(const RobotPose& last_good, const RobotPose& odometry_then,
                      const RobotPose& odometry_now);
 
+// The segments the matchers accept (finite, at least 1 pixel long): an extractor may produce
+// degenerate ones, which the matchers reject as bad input.
+std::vector<Segment2> UsableSegments(const std::vector<Segment2>& lines);
+
 // One matcher run.
 struct RelocalizationAttempt {
   bool found = false;

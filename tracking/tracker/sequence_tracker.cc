@@ -79,6 +79,7 @@ bool SequenceTrackerOptions::Check(std::string* why) const {
   tolerances.roll = 0.0;
   if (!health.Check(why) || !motion.Check(why) || !tolerances.Check(why)) return false;
   if (!integrity.Check(why) || !reacquisition.Check(why) || !coast.Check(why)) return false;
+  if (!global.Check(why)) return false;
   if (restart_window < 0) {
     *why = "restart window must be >= 0 frames";
     return false;
@@ -163,6 +164,8 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
                              const std::optional<RobotReading>& robot, const char* source,
                              FrameReport* report) {
   following_ = true;
+  ever_good_ = true;
+  failed_searches_ = 0;
   last_good_ = GoodPose{result.cam_from_world, t, robot, driven_m_};
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
@@ -235,6 +238,7 @@ bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robo
     r.robot = robot;
     r.driven_at_start_m = driven_m_;
     if (started_after) r.before = *started_after;
+    r.global = global_mode_;
     const GoodPose* before = r.before ? &*r.before : nullptr;
     if (before && odometry && before->robot && before->robot->odometry) {
       const Eigen::Vector2d d =
@@ -295,6 +299,11 @@ void SequenceTracker::Drop(const std::string& why, FrameReport* report) {
   if (reacquisition_ && reacquisition_->before) {
     last_good_ = reacquisition_->before;
     last_good_index_ = frame_index_;
+  }
+  // A global pose that fails its confirmation leaves nothing to search around: global again.
+  if (reacquisition_ && reacquisition_->global) {
+    global_mode_ = true;
+    last_good_.reset();
   }
   reacquisition_.reset();
   report->status = TrackStatus::kLost;
@@ -375,6 +384,131 @@ void SequenceTracker::Follow(double t, const std::optional<RobotReading>& robot,
   if (reacquisition_ && !CheckReacquisition(robot, nullptr, report)) Drop(report->note, report);
 }
 
+void SequenceTracker::EnterGlobalMode(const std::string& why) {
+  following_ = false;
+  last_good_.reset();
+  reacquisition_.reset();
+  recent_projection_errors_.clear();
+  recent_refined_rms_.clear();
+  global_mode_ = true;
+  global_reason_ = why;
+  failed_searches_ = 0;
+}
+
+void SequenceTracker::RequestGlobal() {
+  start_pose_.reset();
+  initial_prior_.reset();
+  EnterGlobalMode("asked");
+}
+
+bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot,
+                               FrameReport* report) {
+  const GlobalRecoveryOptions& o = options_.global;
+  if (!global_ || !o.check_relocalisations || !ever_good_) return false;
+  const GlobalAttempt g = global_->Attempt(*undistorted_, robot.height, robot.tilt);
+  std::string rival;
+  if (g.ambiguous) {
+    rival = "the global mode finds the view ambiguous (" + std::to_string(g.rivals) + " rivals)";
+  } else if (g.found) {
+    const Eigen::Vector2d d = PlanarDifference(PlanarOf(g.cam_from_world), PlanarOf(pose));
+    if (d[0] > o.rival_distance_m || d[1] > DegToRad(o.rival_heading_deg)) {
+      rival = "the global mode finds a pose " + Fixed(d[0], 2) + " m / " +
+              Fixed(RadToDeg(d[1]), 1) + " deg away";
+    }
+  }
+  if (rival.empty()) return false;
+  EnterGlobalMode("the matcher's pose near the prior has a rival: " + rival);
+  report->cam_from_world.reset();
+  report->source = "global";
+  report->note = "global mode (" + global_reason_ + ")";
+  return true;
+}
+
+void SequenceTracker::MaybeSwitchToGlobal(const RobotReading& robot) {
+  if (global_mode_) return;
+  LossState state;
+  RobotPose prior;
+  SearchBounds bounds;
+  state.has_prior = relocalizer_ && MatcherPrior(robot, &prior, &bounds);
+  state.frames_since_good = last_good_ ? FramesSinceGood() : static_cast<int>(frame_index_ + 1);
+  state.failed_searches = failed_searches_;
+  if (robot.odometry) state.driven_since_m = driven_m_ - (last_good_ ? last_good_->driven_m : 0.0);
+  const std::string why = GlobalModeReason(state, options_.global);
+  if (why.empty()) return;
+  // The old pose and its statistics say nothing of where the robot is now.
+  EnterGlobalMode(why);
+}
+
+bool SequenceTracker::TryGlobal(double t, const RobotReading& robot, FrameReport* report) {
+  report->source = "global";
+  const GlobalAttempt attempt = global_->Attempt(*undistorted_, robot.height, robot.tilt);
+  report->lines = attempt.lines;
+  const std::string mode = "global mode (" + global_reason_ + "): ";
+  if (!attempt.found) {
+    report->note = mode + attempt.reason;
+    return false;
+  }
+  if (!StartAndVerify(attempt.cam_from_world, t, robot, report)) {
+    report->note = mode + "its pose is not confirmed by the edges: " + report->note;
+    return false;
+  }
+  return true;
+}
+
+const char* SequenceTracker::Search(double t, const std::optional<RobotReading>& robot,
+                                    const std::optional<CoastedPose>& coasted,
+                                    FrameReport* report) {
+  if (start_pose_ && StartAndVerify(*start_pose_, t, robot, report)) {
+    start_pose_.reset();
+    global_mode_ = false;
+    return "start pose";
+  }
+  if (global_ && robot) {
+    MaybeSwitchToGlobal(*robot);
+    if (global_mode_) return TryGlobal(t, *robot, report) ? "global" : nullptr;
+  }
+  // The coasted pose is where the last reported pose is now: restart there first.
+  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
+  std::string restart_note;
+  if (options_.restart_from_last_good && coasting) {
+    if (StartAndVerify(coasted->cam_from_world, t, robot, report)) return "restart";
+    restart_note = report->note;
+  }
+  if (relocalizer_ && robot) {
+    RobotPose prior;
+    SearchBounds bounds;
+    if (MatcherPrior(*robot, &prior, &bounds)) {
+      const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
+      report->lines = attempt.lines;
+      // The frame disagrees with the prior only when the matcher finds nothing around it; a pose
+      // found there that the edges do not hold says the prior still fits.
+      if (attempt.found) {
+        failed_searches_ = 0;
+      } else if (attempt.lines >= options_.global.kidnap_min_lines) {
+        ++failed_searches_;
+      }
+      if (!attempt.found) {
+        report->note = attempt.reason;
+      } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
+        return HasRival(attempt.cam_from_world, *robot, report) ? nullptr : "matcher";
+      }
+    } else {
+      report->note = "no prior for the matcher";
+    }
+  }
+  if (options_.restart_from_last_good && !coasting && last_good_ &&
+      FramesSinceGood() <= options_.restart_window) {
+    const std::string matcher_note = report->note;
+    if (StartAndVerify(last_good_->cam_from_world, t, robot, report)) return "restart";
+    if (!matcher_note.empty()) report->note = matcher_note + "; restart: " + report->note;
+  }
+  if (!restart_note.empty()) report->note += "; restart: " + restart_note;
+  if (!start_pose_ && !(relocalizer_ && robot) && !last_good_) {
+    report->note = "no start pose and no prior";
+  }
+  return nullptr;
+}
+
 FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double t,
                                      const std::optional<RobotReading>& robot) {
   const Clock::time_point start = Clock::now();
@@ -400,47 +534,8 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
 
   // Not following: find the pose (again). Candidates in order; each is verified by tracking.
   const Clock::time_point search_start = Clock::now();
-  const bool had_pose = last_good_.has_value();
-  const char* source = nullptr;
-  auto try_candidate = [&](const Eigen::Isometry3d& candidate, const char* name) {
-    if (!StartAndVerify(candidate, t, robot, &report)) return false;
-    source = name;
-    return true;
-  };
-  if (start_pose_ && try_candidate(*start_pose_, "start pose")) start_pose_.reset();
-  // The coasted pose is where the last reported pose is now: restart there first.
-  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
-  std::string restart_note;
-  if (!source && options_.restart_from_last_good && coasting &&
-      !try_candidate(coasted->cam_from_world, "restart")) {
-    restart_note = report.note;
-  }
-  if (!source && relocalizer_ && robot) {
-    RobotPose prior;
-    SearchBounds bounds;
-    if (MatcherPrior(*robot, &prior, &bounds)) {
-      const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
-      report.lines = attempt.lines;
-      if (!attempt.found) {
-        report.note = attempt.reason;
-      } else {
-        try_candidate(attempt.cam_from_world, "matcher");
-      }
-    } else {
-      report.note = "no prior for the matcher";
-    }
-  }
-  if (!source && options_.restart_from_last_good && !coasting && last_good_ &&
-      FramesSinceGood() <= options_.restart_window) {
-    const std::string matcher_note = report.note;
-    if (!try_candidate(last_good_->cam_from_world, "restart") && !matcher_note.empty()) {
-      report.note = matcher_note + "; restart: " + report.note;
-    }
-  }
-  if (!source && !restart_note.empty()) report.note += "; restart: " + restart_note;
-  if (!source && !start_pose_ && !(relocalizer_ && robot) && !last_good_) {
-    report.note = "no start pose and no prior";
-  }
+  const bool had_pose = ever_good_;
+  const char* source = Search(t, robot, coasted, &report);
   report.relocalize_ms = MillisecondsSince(search_start);
   if (source) {
     const Eigen::Isometry3d pose = *report.cam_from_world;
@@ -454,10 +549,22 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     report.status = had_pose ? TrackStatus::kRelocalised : TrackStatus::kTracking;
     if (had_pose) ++recoveries_;
     Assess(verified_observations_, robot, &report);
-    const bool matcher = std::string(source) == "matcher";
-    if ((matcher || reacquisition_) &&
-        !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
+    // A global pose has no pose before it: its check starts afresh, against nothing.
+    const bool global = std::string(source) == "global";
+    if (global) before.reset();
+    const bool matcher = global || std::string(source) == "matcher";
+    if (global && !report.cam_from_world) {
+      // The integrity monitor finds the global pose lost: nothing to confirm, search again.
+      following_ = false;
+      last_good_.reset();
+    } else if ((matcher || reacquisition_) &&
+               !CheckReacquisition(robot, matcher ? &before : nullptr, &report)) {
       Drop(report.note, &report);
+    }
+    if (global && report.cam_from_world) {
+      report.uncertainty.reason =
+          "global mode (" + global_reason_ + "); " + report.uncertainty.reason;
+      global_mode_ = false;
     }
   } else {
     report.status = had_pose ? TrackStatus::kLost : TrackStatus::kInitialising;

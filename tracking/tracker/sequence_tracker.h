@@ -15,6 +15,7 @@
 #include "models/robot_pose.h"
 #include "tracking/integrity/integrity_monitor.h"
 #include "tracking/tracker/edge_tracker.h"
+#include "tracking/tracker/global_recovery.h"
 #include "tracking/tracker/image_undistorter.h"
 #include "tracking/tracker/odometry_coast.h"
 #include "tracking/tracker/relocalizer.h"
@@ -99,6 +100,8 @@ struct SequenceTrackerOptions {
   // good poses whose residual merely fluctuates (the trade-off: docs/tracking.md, health).
   double rms_jump_ratio = 2.5;
   double rms_jump_floor_px = 0.3;
+  // When a lost robot switches to the global mode (with a GlobalRecovery: SetGlobalRecovery).
+  GlobalRecoveryOptions global;
 
   bool Check(std::string* why) const;
 };
@@ -114,7 +117,8 @@ struct FrameReport {
   PoseUncertainty uncertainty;
   TrackHealth health;  // of the last tracking on this frame
   bool health_measured = false;
-  // Where the pose came from: "tracker", "start pose", "matcher", "restart", "odometry" (coasted).
+  // Where the pose came from: "tracker", "start pose", "matcher", "restart", "global", "odometry"
+  // (coasted); on a frame without a pose, "global" when the global mode searched it.
   std::string source;
   std::string note;        // why there is no pose (empty otherwise)
   int lines = -1;          // segments extracted when the matcher ran, else -1
@@ -142,6 +146,13 @@ class SequenceTracker {
   // Prior of the first localisation of a robot without a prior file (x, y, heading).
   void SetInitialPrior(const Pose3Dof& prior) { initial_prior_ = prior; }
 
+  // The global mode of a lost robot (null: none); it must outlive the sequence tracker.
+  void SetGlobalRecovery(const GlobalRecovery* global) { global_ = global; }
+
+  // Drops the pose and every prior: the next frames are localised by the global mode (when
+  // there is one), each answer confirmed like a matcher's before it is `tracking`.
+  void RequestGlobal();
+
   // Processes one frame taken at `t` seconds; `robot` is absent for a free camera.
   FrameReport Process(const vpImage<unsigned char>& image, double t,
                       const std::optional<RobotReading>& robot);
@@ -155,6 +166,8 @@ class SequenceTracker {
   // A matcher's pose is being confirmed (ReacquisitionCheck): its poses are reported degraded
   // until it is.
   bool reacquiring() const { return reacquisition_.has_value(); }
+  // The frames are localised by the global mode until one of its poses is found.
+  bool global_mode() const { return global_mode_; }
 
  private:
   struct GoodPose {
@@ -173,6 +186,21 @@ class SequenceTracker {
   // The matcher's prior for this frame (robot only) and its bounds; false when there is none.
   bool MatcherPrior(const RobotReading& robot, RobotPose* prior, SearchBounds* bounds) const;
   int FramesSinceGood() const { return static_cast<int>(frame_index_ - last_good_index_); }
+  // The candidates of a frame not followed, in order (start pose, global mode, or the coasted
+  // pose, the matcher and a restart), each verified by tracking: the source of the verified one,
+  // else null.
+  const char* Search(double t, const std::optional<RobotReading>& robot,
+                     const std::optional<CoastedPose>& coasted, FrameReport* report);
+  // Switches to the global mode when the loss calls for it (GlobalModeReason).
+  void MaybeSwitchToGlobal(const RobotReading& robot);
+  // Enters the global mode: the old pose, its reacquisition and jump statistics are dropped.
+  void EnterGlobalMode(const std::string& why);
+  // After a loss, the global mode's answer on the frame against the matcher's `pose`
+  // (GlobalRecoveryOptions::check_relocalisations): true (and the global mode entered) when it
+  // has a rival elsewhere or is ambiguous.
+  bool HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot, FrameReport* report);
+  // Localises the frame with the global mode and verifies its pose; false when none.
+  bool TryGlobal(double t, const RobotReading& robot, FrameReport* report);
   // With odometry now and at the last frame: restarts the tracker from the predicted pose when
   // the predicted image motion is large.
   void MaybePredict(const std::optional<RobotReading>& robot, FrameReport* report);
@@ -209,11 +237,13 @@ class SequenceTracker {
     double jump_m = 0.0;    // distance from where the odometry carries the good pose before
     std::string jump;       // that disagreement in words, when beyond the allowance
     std::optional<GoodPose> before;
+    bool global = false;  // found by the global mode (no pose before it to compare)
   };
 
   EdgeTracker* tracker_;
   ImageUndistorter undistorter_;
   const Relocalizer* relocalizer_;
+  const GlobalRecovery* global_ = nullptr;
   SequenceTrackerOptions options_;
   const vpImage<unsigned char>* undistorted_ = nullptr;
   vpImage<unsigned char> empty_;
@@ -229,7 +259,11 @@ class SequenceTracker {
   std::deque<double> recent_projection_errors_;         // of the last good frames
   std::deque<double> recent_refined_rms_;  // refinement residuals of the last good frames
   bool following_ = false;                 // the tracker holds a good pose from the previous frame
-  long frame_index_ = -1;                  // frames processed - 1
+  bool ever_good_ = false;                 // a pose was accepted on some frame
+  bool global_mode_ = false;               // lost frames are localised by the global mode
+  int failed_searches_ = 0;    // matcher searches in a row finding nothing (GlobalRecoveryOptions)
+  std::string global_reason_;  // why the global mode was entered
+  long frame_index_ = -1;      // frames processed - 1
   long last_good_index_ = -1;
   int losses_ = 0;
   int recoveries_ = 0;

@@ -8,12 +8,15 @@
 #include <optional>
 #include <string>
 
+#include "matching/global/global_localizer.h"
+#include "matching/heading/model_directions.h"
 #include "matching/lines/line_extractor.h"
 #include "matching/localizer.h"
 #include "models/camera.h"
 #include "models/navigable_area.h"
 #include "models/view_invariant_regions.h"
 #include "tracking/tracker/edge_tracker.h"
+#include "tracking/tracker/global_recovery.h"
 #include "tracking/tracker/relocalizer.h"
 #include "tracking/tracker/sequence_tracker.h"
 
@@ -39,7 +42,8 @@ struct TrackingEngineModel {
 
 class TrackingEngine {
  public:
-  // Builds the matcher (when regions and area are given), the line extractor and the tracker
+  // Builds the matcher (when regions and area are given), its global mode (with
+  // options.sequence.global.enabled and horizontal model edges), the line extractor and the tracker
   // for frames of `camera` (distorted as they come: undistorted inside). Throws InputError on
   // invalid options or a model ViSP cannot load.
   TrackingEngine(const TrackingEngineModel& model, const CameraIntrinsics& camera,
@@ -58,10 +62,14 @@ class TrackingEngine {
   SequenceTracker& sequence() { return *sequence_; }
   const SequenceTracker& sequence() const { return *sequence_; }
   bool has_matcher() const { return relocalizer_ != nullptr; }
+  bool has_global_mode() const { return global_ != nullptr; }
 
  private:
   std::unique_ptr<Localizer> localizer_;
   std::unique_ptr<Relocalizer> relocalizer_;
+  ModelDirections directions_;
+  std::unique_ptr<GlobalLocalizer> global_localizer_;
+  std::unique_ptr<GlobalRecovery> global_;
   std::unique_ptr<EdgeTracker> tracker_;
   std::unique_ptr<SequenceTracker> sequence_;
 };

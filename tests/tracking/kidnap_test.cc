@@ -1,0 +1,182 @@
+// The kidnapped robot on a rendered drive of the bundled hall: the robot tracks along the hall
+// loop, is lifted and put down on the far side of the hall (its odometry blind to the carry) and
+// drives on. The tracking engine must notice that the frames disagree with the carried prior,
+// switch to the global mode, find the new pose, confirm it over frames against the odometry, and
+// report no wrong `tracking` pose meanwhile. The switch's rule is checked on its own.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "models/navigable_area.h"
+#include "models/render/kidnap.h"
+#include "models/render/scene_renderer.h"
+#include "models/render/sequence.h"
+#include "models/view_invariant_regions.h"
+#include "tracking/integrity/consistency.h"
+#include "tracking/live/tracker_estimator.h"
+#include "tracking/tracker/global_recovery.h"
+#include "tracking/tracker/tracking_engine.h"
+
+namespace linetrack {
+namespace {
+
+constexpr int kFrames = 36;               // 3.6 s at 10 frames/s
+constexpr int kKidnapFrame = 12;          // put down on this frame
+constexpr int kMaxFramesToTracking = 10;  // from the put-down to a confirmed pose
+constexpr double kNearM = 0.10;           // integrity rules: a `tracking` pose beyond is wrong
+constexpr double kNearDeg = 2.0;
+constexpr double kGlobalPoseM = 0.03;  // the global mode's verified pose against the truth
+constexpr double kGlobalPoseDeg = 0.5;
+
+const std::string kSource = LINETRACK_SOURCE_DIR;
+
+// The hall loop driven from its start; on kKidnapFrame the robot is put down where the loop is
+// half a lap further on, and drives on from there.
+struct KidnapDrive {
+  WireframeModel model = WireframeModel::Load(kSource + "/models/hall.cao");
+  CameraIntrinsics camera = ReadCameraXml(kSource + "/tests/data/camera_wide.xml");
+  NavigableArea area = NavigableArea::FromModel(model, AreaOptions());
+  std::vector<SequenceFrame> frames;
+  std::vector<PriorRecord> priors;
+  std::vector<vpImage<unsigned char>> images;
+
+  static NavigableAreaOptions AreaOptions() {
+    NavigableAreaOptions nav;
+    nav.sidecar_path = kSource + "/tests/data/hall.nav.json";
+    return nav;
+  }
+
+  KidnapDrive() {
+    DriveOptions drive;
+    drive.tilt = DegToRad(5.0);
+    std::vector<SequenceFrame> lap = DriveAlongLoop(LoopInsideArea(area), drive);
+    const Pose3Dof put_down = lap[kKidnapFrame + lap.size() / 2].base.Planar();
+    lap.resize(kFrames);
+    priors = SimulateOdometryPriors(lap, OdometryOptions());
+    frames = ApplyKidnaps(lap, {{kKidnapFrame, put_down}}, &area);
+    RenderOptions render;
+    render.scene.clutter = 10;
+    SceneRenderer renderer(model, camera, render, &area);
+    for (int i = 0; i < kFrames; ++i)
+      images.push_back(renderer.Render(frames[i].cam_from_world, i));
+  }
+};
+
+const KidnapDrive& Drive() {
+  static const KidnapDrive drive;
+  return drive;
+}
+
+std::vector<FrameReport> Replay(const KidnapDrive& d, const TrackingEngineOptions& options) {
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(d.model, d.area);
+  TrackingEngine engine({kSource + "/models/hall.cao", &d.model, &regions, &d.area}, d.camera,
+                        options);
+  std::vector<FrameReport> reports;
+  for (int i = 0; i < kFrames; ++i) {
+    reports.push_back(engine.Process(d.images[i], d.frames[i].t, RobotReadingOf(d.priors[i].pose)));
+  }
+  return reports;
+}
+
+TrackingEngineOptions EngineOptions() {
+  TrackingEngineOptions options;
+  options.matcher.noise = DetectedLineNoise();
+  return options;
+}
+
+// No `tracking` pose beyond its protection levels or the near bounds (docs/integrity.md).
+void ExpectNoWrongTrackingPose(const std::vector<FrameReport>& reports, const KidnapDrive& d) {
+  for (int i = 0; i < kFrames; ++i) {
+    const FrameReport& r = reports[i];
+    if (!r.cam_from_world || r.uncertainty.status != IntegrityStatus::kTracking) continue;
+    const WorldTwist e = WorldTwistBetween(d.frames[i].cam_from_world, *r.cam_from_world);
+    const PoseDifference diff = ComparePoses(*r.cam_from_world, d.frames[i].cam_from_world);
+    EXPECT_LE(e.head<2>().norm(), r.uncertainty.protection_position_m) << "frame " << i;
+    EXPECT_LE(std::abs(e[5]), r.uncertainty.protection_rotation_rad) << "frame " << i;
+    EXPECT_LE(diff.translation, kNearM) << "frame " << i;
+    EXPECT_LE(RadToDeg(diff.rotation), kNearDeg) << "frame " << i;
+  }
+}
+
+TEST(KidnappedRobot, TheGlobalModeFindsTheNewPoseAndConfirmsItWithNoWrongPose) {
+  const KidnapDrive& d = Drive();
+  const std::vector<FrameReport> reports = Replay(d, EngineOptions());
+  for (int i = 0; i < kKidnapFrame; ++i) {
+    EXPECT_TRUE(reports[i].cam_from_world.has_value()) << "frame " << i << ": " << reports[i].note;
+  }
+  int global = -1, tracking = -1;
+  for (int i = kKidnapFrame; i < kFrames; ++i) {
+    const FrameReport& r = reports[i];
+    if (global < 0 && r.source == "global" && r.cam_from_world) global = i;
+    if (tracking < 0 && r.cam_from_world && r.uncertainty.status == IntegrityStatus::kTracking)
+      tracking = i;
+  }
+  std::string trace;  // the frames from the put-down, for a failure's message
+  for (int i = kKidnapFrame; i < kFrames; ++i) {
+    const FrameReport& r = reports[i];
+    trace += "\nframe " + std::to_string(i) + ": " + ToString(r.status) + ", " +
+             ToString(r.uncertainty.status) + ", " + r.source + ", " +
+             (r.note.empty() ? r.uncertainty.reason : r.note);
+  }
+  ASSERT_GE(global, kKidnapFrame) << "the global mode found no pose" << trace;
+  EXPECT_NE(reports[global].uncertainty.reason.find("global mode"), std::string::npos)
+      << reports[global].uncertainty.reason;
+  EXPECT_EQ(reports[global].status, TrackStatus::kRelocalised);
+  EXPECT_NE(reports[global].uncertainty.status, IntegrityStatus::kTracking);
+  const PoseDifference found =
+      ComparePoses(*reports[global].cam_from_world, d.frames[global].cam_from_world);
+  EXPECT_LE(found.translation, kGlobalPoseM);
+  EXPECT_LE(RadToDeg(found.rotation), kGlobalPoseDeg);
+  ASSERT_GE(tracking, global) << "the global pose was never confirmed" << trace;
+  EXPECT_LE(tracking - kKidnapFrame, kMaxFramesToTracking) << trace;
+  ExpectNoWrongTrackingPose(reports, d);
+}
+
+// The control: without the global mode the engine searches around the carried prior and does
+// not find the robot again in the same frames.
+TEST(KidnappedRobot, WithoutTheGlobalModeTheRobotIsNotFoundAgain) {
+  TrackingEngineOptions options = EngineOptions();
+  options.sequence.global.enabled = false;
+  const std::vector<FrameReport> reports = Replay(Drive(), options);
+  for (int i = kKidnapFrame; i <= kKidnapFrame + kMaxFramesToTracking; ++i) {
+    EXPECT_FALSE(reports[i].cam_from_world &&
+                 reports[i].uncertainty.status == IntegrityStatus::kTracking)
+        << "frame " << i;
+  }
+  ExpectNoWrongTrackingPose(reports, Drive());
+}
+
+TEST(GlobalModeReason, EachTriggerAndItsThreshold) {
+  GlobalRecoveryOptions o;
+  o.kidnap_frames = 3;
+  o.lost_frames = 25;
+  o.lost_distance_m = 3.0;
+  LossState s;
+  s.has_prior = false;
+  EXPECT_EQ(GlobalModeReason(s, o), "no prior");
+  s.has_prior = true;
+  s.frames_since_good = 2;
+  s.failed_searches = 2;
+  s.driven_since_m = 0.2;
+  EXPECT_EQ(GlobalModeReason(s, o), "");
+  s.failed_searches = 3;
+  EXPECT_NE(GlobalModeReason(s, o).find("carried away"), std::string::npos);
+  s.failed_searches = 0;
+  s.frames_since_good = 25;
+  EXPECT_EQ(GlobalModeReason(s, o), "lost 25 frames");
+  s.frames_since_good = 24;
+  s.driven_since_m = 3.0;
+  EXPECT_EQ(GlobalModeReason(s, o), "lost over 3.0 m");
+  s.driven_since_m = -1.0;  // no odometry: distance says nothing
+  EXPECT_EQ(GlobalModeReason(s, o), "");
+  o.lost_frames = 0;  // off
+  s.frames_since_good = 1000;
+  EXPECT_EQ(GlobalModeReason(s, o), "");
+  std::string why;
+  o.kidnap_frames = -1;
+  EXPECT_FALSE(o.Check(&why));
+}
+
+}  // namespace
+}  // namespace linetrack

@@ -1,0 +1,76 @@
+#include "tracking/tracker/global_recovery.h"
+
+#include <chrono>
+
+#include "models/errors.h"
+#include "models/text_format.h"
+#include "tracking/tracker/relocalizer.h"
+
+namespace linetrack {
+
+bool GlobalRecoveryOptions::Check(std::string* why) const {
+  if (kidnap_frames < 0 || lost_frames < 0 || kidnap_min_lines < 0) {
+    *why = "global mode: frames before the switch must be >= 0 (0: off)";
+    return false;
+  }
+  if (!(rival_distance_m > 0.0) || !(rival_heading_deg > 0.0)) {
+    *why = "global mode: the rival distance and heading must be > 0";
+    return false;
+  }
+  if (!(lost_distance_m >= 0.0)) {
+    *why = "global mode: the distance must be >= 0 metres (0: off)";
+    return false;
+  }
+  return true;
+}
+
+std::string GlobalModeReason(const LossState& s, const GlobalRecoveryOptions& o) {
+  if (!s.has_prior) return "no prior";
+  const bool odometry = s.driven_since_m >= 0.0;
+  if (o.kidnap_frames > 0 && s.failed_searches >= o.kidnap_frames) {
+    return "carried away: " + std::to_string(s.failed_searches) +
+           " frames with lines disagree with the carried prior";
+  }
+  if (o.lost_frames > 0 && s.frames_since_good >= o.lost_frames) {
+    return "lost " + std::to_string(s.frames_since_good) + " frames";
+  }
+  if (o.lost_distance_m > 0.0 && odometry && s.driven_since_m >= o.lost_distance_m) {
+    return "lost over " + Fixed(s.driven_since_m, 1) + " m";
+  }
+  return "";
+}
+
+GlobalRecovery::GlobalRecovery(const GlobalLocalizer& global, LineExtractorFunction extractor,
+                               int min_lines)
+    : global_(global), extractor_(std::move(extractor)), min_lines_(min_lines) {
+  if (!extractor_) throw InputError("global recovery: no line extractor");
+}
+
+GlobalAttempt GlobalRecovery::Attempt(const vpImage<unsigned char>& undistorted, double height,
+                                      double tilt) const {
+  const auto start = std::chrono::steady_clock::now();
+  GlobalAttempt attempt;
+  GlobalProblem problem;
+  problem.lines = UsableSegments(extractor_(undistorted));
+  problem.height = height;
+  problem.tilt = tilt;
+  attempt.lines = static_cast<int>(problem.lines.size());
+  if (attempt.lines < min_lines_) {
+    attempt.reason = "global: " + std::to_string(attempt.lines) + " lines extracted";
+    attempt.ms = MillisecondsSince(start);
+    return attempt;
+  }
+  const GlobalResult result = global_.Localize(problem);
+  attempt.ms = MillisecondsSince(start);
+  attempt.ambiguous = result.ambiguous;
+  attempt.rivals = static_cast<int>(result.rivals.size());
+  if (result.found && !result.ambiguous) {
+    attempt.found = true;
+    attempt.cam_from_world = result.best.cam_from_world;
+  } else {
+    attempt.reason = "global: " + result.reason;
+  }
+  return attempt;
+}
+
+}  // namespace linetrack
