@@ -393,6 +393,7 @@ void SequenceTracker::EnterGlobalMode(const std::string& why) {
   global_mode_ = true;
   global_reason_ = why;
   failed_searches_ = 0;
+  anchor_.reset();  // the odometry carries the old pose, not the robot
 }
 
 void SequenceTracker::RequestGlobal() {
@@ -584,7 +585,7 @@ std::optional<CoastedPose> SequenceTracker::CoastToFrame(
 
 void SequenceTracker::Combine(const std::optional<RobotReading>& robot,
                               const std::optional<CoastedPose>& coasted, FrameReport* report) {
-  if (!options_.coast.enabled || !robot || !robot->odometry) {
+  if (!options_.coast.enabled || !robot || !robot->odometry || global_mode_) {
     anchor_.reset();
     return;
   }
@@ -610,6 +611,13 @@ void SequenceTracker::Combine(const std::optional<RobotReading>& robot,
     report_coasted();
     report->status = TrackStatus::kCoasting;
     report->note = coasted->note + (image.empty() ? "" : "; image: " + image);
+    // The odometry's bound holds for a robot that drove, not for one that was carried: a frame
+    // with lines on which the matcher finds nothing around the carried pose may show a carry.
+    if (failed_searches_ > 0 && u.status == IntegrityStatus::kTracking) {
+      u.status = IntegrityStatus::kDegraded;
+      const char* why = "the matcher finds nothing around the pose the odometry carries";
+      u.reason = u.reason.empty() ? why : why + ("; " + u.reason);
+    }
     return;
   }
   // An unconfirmed matcher's pose: its levels are not trusted yet (ReacquisitionCheck).
