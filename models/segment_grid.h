@@ -73,8 +73,14 @@ class SegmentGrid {
                   double max_t) const;
 
  private:
-  int Col(double x) const;
-  int Row(double y) const;
+  // floor(value) clamped to [0, count - 1] before the cast (NaN gives 0): no overflow.
+  static int ClampedIndex(double value, int count) {
+    const double f = std::floor(value);
+    if (!(f > 0.0)) return 0;
+    return f >= count - 1 ? count - 1 : static_cast<int>(f);
+  }
+  int Col(double x) const { return ClampedIndex((x - origin_.x()) / cell_, cols_); }
+  int Row(double y) const { return ClampedIndex((y - origin_.y()) / cell_, rows_); }
   // Calls visit(cell) for the cells segment a -> b passes through, from a (Amanatides-Woo);
   // stops when visit returns true (and returns true then).
   template <typename Visit>

@@ -15,15 +15,17 @@
 
 namespace linetrack {
 
-// One model edge in a region's visibility list. Bearings are world angles (radians,
-// counter-clockwise from +x) of the directions from points of the region to points of the edge,
-// projected on the floor plane: the interval [bearing_min, bearing_max] (bearing_max may exceed
-// pi; width < 2 pi) unless all_bearings (the edge passes over the region).
+// One model edge in a region's visibility list. Bearings are world angles (counter-clockwise from
+// +x) of the directions from points of the region to points of the edge, projected on the floor
+// plane, held as diamond angles (DiamondAngle, models/geometry.h: monotone in the bearing, no
+// transcendental function): the arc [diamond_min, diamond_max] (diamond_min in [0, 4),
+// diamond_max - diamond_min < 2, a half turn) unless all_bearings (the edge passes over the
+// region).
 struct RegionEdge {
   int edge_id = -1;
-  double bearing_min = 0.0;
-  double bearing_max = 0.0;
   bool all_bearings = false;
+  double diamond_min = 0.0;
+  double diamond_max = 0.0;
 };
 
 // A convex cell of the navigable area on one storey and its visibility list (sorted by edge id).

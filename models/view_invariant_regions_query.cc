@@ -16,11 +16,15 @@
 namespace linetrack {
 namespace {
 
+// Arcs of bearings (radians) or of diamond angles this close count as meeting: far above the
+// rounding of their ends, and a diamond angle grows at most as fast as the bearing.
+constexpr double kArcSlack = 1e-12;
+
 // True when the arcs [centre_a +- half_a] and [centre_b +- half_b] (radians) meet modulo 2 pi.
 bool ArcsMeet(double centre_a, double half_a, double centre_b, double half_b) {
   double d = centre_a - centre_b;
   d -= 2.0 * kPi * std::floor(d / (2.0 * kPi) + 0.5);  // to [-pi, pi), cheaper than remainder
-  return std::abs(d) <= half_a + half_b + 1e-12;
+  return std::abs(d) <= half_a + half_b + kArcSlack;
 }
 
 // Bearings of q - p for q on the footprint and p in the disk (centre, radius), as an arc
@@ -114,6 +118,9 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
       std::isfinite(query.camera_z) && !storeys_.empty() ? StoreyAt(storeys_, query.camera_z) : -1;
   const double half = query.heading_margin + query.bearing_half_width;
   const bool any_bearing = half >= kPi;
+  // The query's bearings [heading - half, heading + half] as an arc of diamond angles.
+  const double query_min = BearingToDiamond(query.heading - half);
+  const double query_width = WrapDiamond(BearingToDiamond(query.heading + half) - query_min);
   // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
   std::vector<char> state(num_edges_, 0);
   for (int r : candidates) {
@@ -126,9 +133,8 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
         state[e.edge_id] = 1;
         continue;
       }
-      if (!e.all_bearings &&
-          !ArcsMeet(0.5 * (e.bearing_min + e.bearing_max), 0.5 * (e.bearing_max - e.bearing_min),
-                    query.heading, half)) {
+      if (!e.all_bearings && !DiamondArcsMeet(e.diamond_min, e.diamond_max - e.diamond_min,
+                                              query_min, query_width, kArcSlack)) {
         continue;  // another region may still see it under the query's bearings
       }
       double arc_centre = 0.0, arc_half = 0.0;

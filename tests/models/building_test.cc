@@ -160,8 +160,8 @@ TEST(SmallBuilding, RegionListsEqualTheDirectTest) {
     ASSERT_EQ(x.visible.size(), y.visible.size()) << r;
     for (size_t k = 0; k < x.visible.size(); ++k) {
       const RegionEdge &e = x.visible[k], &f = y.visible[k];
-      EXPECT_TRUE(e.edge_id == f.edge_id && e.bearing_min == f.bearing_min &&
-                  e.bearing_max == f.bearing_max && e.all_bearings == f.all_bearings)
+      EXPECT_TRUE(e.edge_id == f.edge_id && e.diamond_min == f.diamond_min &&
+                  e.diamond_max == f.diamond_max && e.all_bearings == f.all_bearings)
           << "region " << r << " entry " << k;
     }
     entries += x.visible.size();
