@@ -254,6 +254,44 @@ bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& sol
   return true;
 }
 
+bool ClipToBearingWedge(const Segment2& footprint, const Eigen::Vector2d& centre, double radius,
+                        double heading, double half, Segment2* part) {
+  *part = footprint;
+  if (!(2.0 * half < kPi)) return true;
+  // A point p seen under bearing b from e in the disk: p - e is counter-clockwise of the arc's
+  // first direction u1 and clockwise of its last u2, so n.(p - centre) >= n.(e - centre) >= -r
+  // for n = u1 turned left and for n = u2 turned right.
+  const double b1 = heading - half, b2 = heading + half;
+  const Eigen::Vector2d normals[2] = {{-std::sin(b1), std::cos(b1)}, {std::sin(b2), -std::cos(b2)}};
+  double t0 = 0.0, t1 = 1.0;
+  const Eigen::Vector2d d = footprint.b - footprint.a;
+  for (const Eigen::Vector2d& n : normals) {
+    // g(t) = n.(a + t d - centre) + r (+ rounding) >= 0 on the part.
+    const double g0 = n.dot(footprint.a - centre) + radius + kTouch, slope = n.dot(d);
+    if (slope == 0.0) {
+      if (g0 < 0.0) return false;
+      continue;
+    }
+    const double t = -g0 / slope;
+    if (slope > 0.0) t0 = std::max(t0, t);
+    if (slope < 0.0) t1 = std::min(t1, t);
+  }
+  if (t0 > t1) return false;
+  *part = {footprint.a + t0 * d, footprint.a + t1 * d};
+  return true;
+}
+
+Ring2 PolygonAroundDisk(const Eigen::Vector2d& centre, double radius, int sides) {
+  // The inscribed circle of a regular polygon of circumradius R is R cos(pi / sides).
+  const double circumradius = radius / std::cos(kPi / sides) + kTouch;
+  Ring2 ring;
+  for (int k = 0; k < sides; ++k) {
+    const double a = 2.0 * kPi * k / sides;
+    ring.push_back(centre + circumradius * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  return ring;
+}
+
 BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
   Eigen::Vector2d lo = region.front(), hi = lo;
   for (const Eigen::Vector2d& r : region)

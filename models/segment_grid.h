@@ -38,6 +38,16 @@ class SegmentGrid {
     });
   }
 
+  // As Along, without the marks that visit each segment once: a segment registered in several
+  // cells on the way is visited once per cell. Safe to call from several threads at once.
+  template <typename Visit>
+  bool AlongEveryCell(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      const Visit& visit) const {
+    return Walk(a, b, [&](size_t cell) {
+      return std::any_of(cells_[cell].begin(), cells_[cell].end(), visit);
+    });
+  }
+
   // Calls visit(i) once for each segment registered in a cell that the convex polygon `ring`,
   // grown by `margin` metres, meets (a superset of the segments within `margin` of it).
   template <typename Visit>

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "models/camera.h"
+#include "models/convex_polygon.h"
 #include "models/navigable_area.h"
+#include "models/segment_grid.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
@@ -103,7 +105,8 @@ class ViewInvariantRegions {
   // Edges possibly visible from the query (sorted ids, each once): the union of the visibility
   // lists of the regions of the camera's storey meeting the disk, keeping an edge when its bearing
   // range meets [heading - margin - half_width, heading + margin + half_width], and so do the
-  // bearings from the disk itself to the edge. Conservative: an edge that ray casting finds visible
+  // bearings from the disk itself to the edge, and the storey's walls do not hide from the disk
+  // the part of the edge under those bearings. Conservative: an edge that ray casting finds visible
   // from a pose inside the query (position in the navigable area, camera height between the model's
   // floor and top) is never missing. Throws InputError on a non-finite or negative field.
   std::vector<int> Query(const VisibilityQuery& query) const;
@@ -120,7 +123,21 @@ class ViewInvariantRegions {
   void BuildStorey(const WireframeModel& model, const NavigableArea& area, int s,
                    const ViewInvariantRegionsOptions& options);
 
+  // True when, seen from anywhere in the query's disk, the storey's walls hide every point of the
+  // edge's footprint under the query's bearings (half: the bearings' half-width, radians).
+  bool HiddenFromDisk(const VisibilityQuery& query, double half, int storey, int edge_id) const;
+
+  // Per storey, its occluding walls (with their lines) and per model edge whether they can hide
+  // it (an edge within the storey's band of camera heights).
+  struct StoreyWalls {
+    SegmentGrid grid = SegmentGrid({});
+    std::vector<Line2> lines;
+    std::vector<char> hideable;
+  };
+
   std::vector<ViewRegion> regions_;
+  std::vector<StoreyWalls> storey_walls_;
+  double hidden_margin_ = 1e-3;  // ViewInvariantRegionsOptions::hidden_margin
   std::vector<Storey> storeys_;
   std::vector<Segment2> occluders_;
   std::vector<Polygon2> solids_;

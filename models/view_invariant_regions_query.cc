@@ -9,6 +9,7 @@
 #include "models/convex_polygon.h"
 #include "models/errors.h"
 #include "models/free_space.h"
+#include "models/plan_visibility.h"
 #include "models/robot_pose.h"
 #include "models/text_format.h"
 #include "models/view_invariant_regions.h"
@@ -140,13 +141,44 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
       double arc_centre = 0.0, arc_half = 0.0;
       const bool narrow =
           DiskBearings(footprints_[e.edge_id], query.centre, query.radius, &arc_centre, &arc_half);
-      state[e.edge_id] = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half) ? 1 : 2;
+      const bool seen = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half);
+      state[e.edge_id] = seen && !HiddenFromDisk(query, half, storey, e.edge_id) ? 1 : 2;
     }
   }
   for (int id = 0; id < num_edges_; ++id) {
     if (state[id] == 1) ids.push_back(id);
   }
   return ids;
+}
+
+bool ViewInvariantRegions::HiddenFromDisk(const VisibilityQuery& query, double half, int storey,
+                                          int edge_id) const {
+  // A piece of the footprint this short is not split further (metres); at most 2^kMaxDepth pieces.
+  constexpr double kMinPiece = 0.05;
+  constexpr int kMaxDepth = 3;
+  if (storey < 0 || storey >= static_cast<int>(storey_walls_.size())) return false;
+  const StoreyWalls& walls = storey_walls_[storey];
+  if (walls.hideable.empty() || !walls.hideable[edge_id]) return false;
+  Segment2 part;
+  if (!ClipToBearingWedge(footprints_[edge_id], query.centre, query.radius, query.heading, half,
+                          &part)) {
+    return true;  // no point of the edge under the query's bearings
+  }
+  const Ring2 disk = PolygonAroundDisk(query.centre, query.radius, 8);
+  // A piece is hidden when one wall hides it from the whole disk (such a wall crosses the sight
+  // line to its middle); the edge when every piece is, the pieces halved where one is not.
+  const auto hidden = [&](const Segment2& piece, int depth, const auto& self) -> bool {
+    const Ring2 footprint = piece.Length() > 0.0 ? Ring2{piece.a, piece.b} : Ring2{piece.a};
+    const bool by_wall = walls.grid.AlongEveryCell(query.centre, piece.Mid(), [&](int i) {
+      return HiddenByWall(disk, footprint, walls.grid.segments()[i], walls.lines[i],
+                          hidden_margin_);
+    });
+    if (by_wall) return true;
+    if (depth >= kMaxDepth || piece.Length() < 2.0 * kMinPiece) return false;
+    return self({piece.a, piece.Mid()}, depth + 1, self) &&
+           self({piece.Mid(), piece.b}, depth + 1, self);
+  };
+  return hidden(part, 0, hidden);
 }
 
 std::string ViewInvariantRegions::ExplainEmptyQuery(const VisibilityQuery& query) const {

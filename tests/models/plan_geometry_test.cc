@@ -221,5 +221,54 @@ TEST(PlanVisibility, BearingRangeHoldsEverySampledBearingAndIsTight) {
   EXPECT_TRUE(BearingsToFootprint(Box(0, 0, 1, 1), {{0.5, 0.5}}).all);
 }
 
+// Every point of the footprint seen from a point of the disk under a bearing of the arc lies in
+// the clipped part, which is part of the footprint.
+TEST(PlanVisibility, BearingWedgeKeepsEveryPointSeenUnderTheArc) {
+  std::mt19937 rng(31u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int seen = 0, clipped = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Eigen::Vector2d centre(4.0 * unit(rng) - 2.0, 4.0 * unit(rng) - 2.0);
+    const double radius = 0.1 + unit(rng), heading = 2.0 * kPi * unit(rng);
+    const double half = 1.6 * unit(rng);
+    const Segment2 footprint{{10.0 * unit(rng) - 5.0, 10.0 * unit(rng) - 5.0},
+                             {10.0 * unit(rng) - 5.0, 10.0 * unit(rng) - 5.0}};
+    Segment2 part;
+    const bool any = ClipToBearingWedge(footprint, centre, radius, heading, half, &part);
+    if (any) {
+      EXPECT_LT(DistanceToSegment(part.a, footprint), kTol);
+      EXPECT_LT(DistanceToSegment(part.b, footprint), kTol);
+      clipped += part.Length() < footprint.Length() - kTol ? 1 : 0;
+    }
+    for (int k = 0; k < 200; ++k) {
+      const double r = radius * std::sqrt(unit(rng)), a = 2.0 * kPi * unit(rng);
+      const Eigen::Vector2d eye = centre + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const Eigen::Vector2d p = footprint.a + unit(rng) * (footprint.b - footprint.a);
+      const double bearing = std::atan2(p.y() - eye.y(), p.x() - eye.x());
+      if (std::abs(WrapAngle(bearing - heading)) > half) continue;
+      ++seen;
+      ASSERT_TRUE(any) << "trial " << trial;
+      EXPECT_LT(DistanceToSegment(p, part), kTol) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(seen, 1000);   // points under the arc are tested
+  EXPECT_GT(clipped, 50);  // and the clip does cut footprints
+}
+
+TEST(PlanVisibility, PolygonAroundDiskHoldsTheDisk) {
+  for (int sides : {3, 8, 13}) {
+    const Eigen::Vector2d centre(1.5, -2.0);
+    const Ring2 ring = PolygonAroundDisk(centre, 0.7, sides);
+    ASSERT_EQ(ring.size(), static_cast<size_t>(sides));
+    EXPECT_GT(RingSignedArea(ring), 0.0);
+    for (int k = 0; k < 360; ++k) {
+      const double a = DegToRad(k);
+      EXPECT_TRUE(
+          ConvexContains(ring, centre + 0.7 * Eigen::Vector2d(std::cos(a), std::sin(a)), 0.0))
+          << sides << " sides, " << k << " deg";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace linetrack
