@@ -1,8 +1,26 @@
 #include "models/geometry.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace linetrack {
+
+double DiamondToBearing(double d) {
+  d = WrapDiamond(d);
+  // On y >= 0, x / l1 = 1 - d and |y| / l1 = 1 - |x| / l1; on y < 0, x / l1 = d - 3.
+  const double c = d <= 2.0 ? 1.0 - d : d - 3.0;
+  const double s = d <= 2.0 ? 1.0 - std::abs(c) : std::abs(c) - 1.0;
+  const double b = std::atan2(s, c);
+  return b < 0.0 ? b + 2.0 * kPi : b;
+}
+
+double BearingToDiamond(double bearing) {
+  return DiamondAngle(std::cos(bearing), std::sin(bearing));
+}
+
+bool DiamondArcsMeet(double a, double a_width, double b, double b_width, double slack) {
+  return WrapDiamond(b - a) <= a_width + slack || WrapDiamond(a - b) <= b_width + slack;
+}
 
 bool ClipSegmentToImage(double width, double height, Segment2* s) {
   const Eigen::Vector2d a = s->a, d = s->b - s->a;

@@ -42,24 +42,13 @@ void AddDirection(const Eigen::Vector2d& v, std::vector<Eigen::Vector2d>* normal
   if (norm > 1e-15) normals->push_back(v / norm);
 }
 
-// False when the boxes of the region and the footprint are too far apart for the footprint to
-// meet the region or come within kTouch of it.
-bool MayTouch(const Ring2& region, const Ring2& footprint) {
-  Eigen::Vector2d r_lo = region.front(), r_hi = r_lo, f_lo = footprint.front(), f_hi = f_lo;
-  for (const Eigen::Vector2d& r : region)
-    r_lo = r_lo.cwiseMin(r), r_hi = r_hi.cwiseMax(r);
+// False when the boxes of the region ([r_lo, r_hi]) and the footprint are too far apart for the
+// footprint to meet the region or come within kTouch of it.
+bool MayTouch(const Eigen::Vector2d& r_lo, const Eigen::Vector2d& r_hi, const Ring2& footprint) {
+  Eigen::Vector2d f_lo = footprint.front(), f_hi = f_lo;
   for (const Eigen::Vector2d& f : footprint)
     f_lo = f_lo.cwiseMin(f), f_hi = f_hi.cwiseMax(f);
   return (f_lo - r_hi).maxCoeff() <= kApart && (r_lo - f_hi).maxCoeff() <= kApart;
-}
-
-// A value in (-2, 2] that increases with atan2(y, x) over (-pi, pi] (the "diamond angle"), for
-// ordering directions without a transcendental function.
-double PseudoAngle(double x, double y) {
-  const double l1 = std::abs(x) + std::abs(y);
-  if (l1 == 0.0) return 0.0;
-  const double t = 1.0 - x / l1;  // 0 along +x, 1 along +-y, 2 along -x
-  return y < 0.0 ? -t : t;
 }
 
 }  // namespace
@@ -194,38 +183,36 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
 
 bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
                   const Line2& line, double margin) {
-  double r_lo = std::numeric_limits<double>::infinity(), r_hi = -r_lo, f_lo = r_lo, f_hi = -r_lo;
-  for (const Eigen::Vector2d& r : region) {
-    r_lo = std::min(r_lo, line.SignedDistance(r));
-    r_hi = std::max(r_hi, line.SignedDistance(r));
-  }
+  // The footprint picks the side (it cannot be `margin` beyond both); the region must be on the
+  // other, every vertex within kTouch.
+  double f_lo = std::numeric_limits<double>::infinity(), f_hi = -f_lo;
   for (const Eigen::Vector2d& f : footprint) {
     f_lo = std::min(f_lo, line.SignedDistance(f));
     f_hi = std::max(f_hi, line.SignedDistance(f));
   }
-  double sign = 0.0;
-  if (r_lo >= -kTouch && f_hi <= -margin) sign = 1.0;
-  if (r_hi <= kTouch && f_lo >= margin) sign = -1.0;
+  const double sign = f_hi <= -margin ? 1.0 : f_lo >= margin ? -1.0 : 0.0;
   if (sign == 0.0) return false;
-  // The chord conv(region + footprint) n line: region points on the line and the crossings of
-  // the segments between the two sides' vertices.
+  for (const Eigen::Vector2d& r : region) {
+    if (sign * line.SignedDistance(r) < -kTouch) return false;
+  }
+  // The chord conv(region + footprint) n line, inside the wall: region points on the line and the
+  // crossings of the segments between the two sides' vertices.
   const Eigen::Vector2d d = line.Direction();
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const double lo = d.dot(wall.a) - kTouch, hi = d.dot(wall.b) + kTouch;
   for (const Eigen::Vector2d& r : region) {
     const double sr = sign * line.SignedDistance(r);
     if (sr <= kTouch) {
-      lo = std::min(lo, d.dot(r));
-      hi = std::max(hi, d.dot(r));
+      const double x = d.dot(r);
+      if (x < lo || x > hi) return false;
       continue;
     }
     for (const Eigen::Vector2d& f : footprint) {
       const double sf = sign * line.SignedDistance(f);
       const double x = d.dot(r + sr / (sr - sf) * (f - r));
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
+      if (x < lo || x > hi) return false;
     }
   }
-  return lo >= d.dot(wall.a) - kTouch && hi <= d.dot(wall.b) + kTouch;
+  return true;
 }
 
 bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin) {
@@ -267,15 +254,56 @@ bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& sol
   return true;
 }
 
-BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
-  return BearingsToFootprint(region, footprint, RingCentroid(region));
+bool ClipToBearingWedge(const Segment2& footprint, const Eigen::Vector2d& centre, double radius,
+                        double heading, double half, Segment2* part) {
+  *part = footprint;
+  if (!(2.0 * half < kPi)) return true;
+  // A point p seen under bearing b from e in the disk: p - e is counter-clockwise of the arc's
+  // first direction u1 and clockwise of its last u2, so n.(p - centre) >= n.(e - centre) >= -r
+  // for n = u1 turned left and for n = u2 turned right.
+  const double b1 = heading - half, b2 = heading + half;
+  const Eigen::Vector2d normals[2] = {{-std::sin(b1), std::cos(b1)}, {std::sin(b2), -std::cos(b2)}};
+  double t0 = 0.0, t1 = 1.0;
+  const Eigen::Vector2d d = footprint.b - footprint.a;
+  for (const Eigen::Vector2d& n : normals) {
+    // g(t) = n.(a + t d - centre) + r (+ rounding) >= 0 on the part.
+    const double g0 = n.dot(footprint.a - centre) + radius + kTouch, slope = n.dot(d);
+    if (slope == 0.0) {
+      if (g0 < 0.0) return false;
+      continue;
+    }
+    const double t = -g0 / slope;
+    if (slope > 0.0) t0 = std::max(t0, t);
+    if (slope < 0.0) t1 = std::min(t1, t);
+  }
+  if (t0 > t1) return false;
+  *part = {footprint.a + t0 * d, footprint.a + t1 * d};
+  return true;
 }
 
-BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
-                                 const Eigen::Vector2d& region_centroid) {
+Ring2 PolygonAroundDisk(const Eigen::Vector2d& centre, double radius, int sides) {
+  // The inscribed circle of a regular polygon of circumradius R is R cos(pi / sides).
+  const double circumradius = radius / std::cos(kPi / sides) + kTouch;
+  Ring2 ring;
+  for (int k = 0; k < sides; ++k) {
+    const double a = 2.0 * kPi * k / sides;
+    ring.push_back(centre + circumradius * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  return ring;
+}
+
+BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint) {
+  Eigen::Vector2d lo = region.front(), hi = lo;
+  for (const Eigen::Vector2d& r : region)
+    lo = lo.cwiseMin(r), hi = hi.cwiseMax(r);
+  return BearingsToFootprint(region, lo, hi, footprint);
+}
+
+BearingRange BearingsToFootprint(const Ring2& region, const Eigen::Vector2d& region_lo,
+                                 const Eigen::Vector2d& region_hi, const Ring2& footprint) {
   BearingRange range;
   range.all = true;
-  const bool may_touch = MayTouch(region, footprint);
+  const bool may_touch = MayTouch(region_lo, region_hi, footprint);
   if (may_touch) {
     if (footprint.size() == 1) {
       if (ConvexContains(region, footprint[0], kTouch)) return range;
@@ -292,31 +320,25 @@ BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
       }
     }
   }
-  // The vectors q - p form a convex set without the origin, within pi of the centre direction;
-  // its extreme bearings are at differences of vertices. They are picked by a pseudo-angle,
-  // monotone in the angle from the centre, and only the two extremes take an atan2.
-  Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& f : footprint)
-    f_mid += f / static_cast<double>(footprint.size());
-  const Eigen::Vector2d centre = f_mid - region_centroid;
-  const double reference = std::atan2(centre.y(), centre.x());
-  double lo_key = std::numeric_limits<double>::infinity(), hi_key = -lo_key;
-  Eigen::Vector2d lo_v = centre, hi_v = centre;
+  // The vectors q - p form a convex set without the origin: their directions span less than a
+  // half turn, where Cross2 orders them exactly as their bearings, and the extremes are differences
+  // of vertices. Only the two extremes take a diamond angle.
+  Eigen::Vector2d lo_v = footprint.front() - region.front(), hi_v = lo_v;
   for (const Eigen::Vector2d& f : footprint) {
     for (const Eigen::Vector2d& r : region) {
       const Eigen::Vector2d v = f - r;
-      if (may_touch && v.norm() <= kTouch) return range;
-      const double key = PseudoAngle(centre.dot(v), Cross2(centre, v));
-      if (key < lo_key) lo_key = key, lo_v = v;
-      if (key > hi_key) hi_key = key, hi_v = v;
+      if (may_touch && v.squaredNorm() <= kTouch * kTouch) return range;
+      if (Cross2(v, lo_v) > 0.0) lo_v = v;  // clockwise of the lowest so far
+      if (Cross2(hi_v, v) > 0.0) hi_v = v;
     }
   }
-  const double lo = std::atan2(Cross2(centre, lo_v), centre.dot(lo_v));  // from the centre
-  const double hi = std::atan2(Cross2(centre, hi_v), centre.dot(hi_v));
-  if (hi - lo >= kPi - 1e-9) return range;
+  const double lo = DiamondAngle(lo_v);
+  double width = WrapDiamond(DiamondAngle(hi_v) - lo);
+  if (width > 3.0) width = 0.0;  // hi_v within rounding of lo_v, its diamond angle just below
+  if (width >= 2.0 - 1e-9) return range;
   range.all = false;
-  range.min = WrapAngle(reference + lo);
-  range.max = range.min + (hi - lo);
+  range.min = lo;
+  range.max = lo + width;
   return range;
 }
 

@@ -55,16 +55,27 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
 // solid (no line separates the solid from a point of each). False when the region overlaps it.
 bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin);
 
-// World bearings (radians) of q - p for p in the region and q in the footprint: [min, max] with
-// min in (-pi, pi], max - min < pi; `all` when the footprint meets the region.
+// The part of the floor-plan `footprint` that a camera anywhere in the disk (centre, radius) can
+// see under a bearing within [heading - half, heading + half] (radians): the footprint clipped to
+// the two half-planes that the disk sweeps along the arc's end directions (when 2 half < pi; the
+// whole footprint otherwise). False when nothing is left.
+bool ClipToBearingWedge(const Segment2& footprint, const Eigen::Vector2d& centre, double radius,
+                        double heading, double half, Segment2* part);
+
+// A counter-clockwise regular polygon of `sides` (>= 3) vertices that holds the disk.
+Ring2 PolygonAroundDisk(const Eigen::Vector2d& centre, double radius, int sides);
+
+// World bearings of q - p for p in the region and q in the footprint, as diamond angles
+// (DiamondAngle, models/geometry.h): [min, max] with min in [0, 4), max - min < 2 (a half turn);
+// `all` when the footprint meets the region.
 struct BearingRange {
   double min = 0.0;
   double max = 0.0;
   bool all = false;
 };
 BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint);
-// The same, given RingCentroid(region).
-BearingRange BearingsToFootprint(const Ring2& region, const Ring2& footprint,
-                                 const Eigen::Vector2d& region_centroid);
+// The same, given the region's bounding box [region_lo, region_hi].
+BearingRange BearingsToFootprint(const Ring2& region, const Eigen::Vector2d& region_lo,
+                                 const Eigen::Vector2d& region_hi, const Ring2& footprint);
 
 }  // namespace linetrack

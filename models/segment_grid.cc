@@ -37,13 +37,6 @@ double RayHit(const Eigen::Vector2d& a, const Eigen::Vector2d& d, const Segment2
   return u >= 0.0 && u <= 1.0 ? t : std::numeric_limits<double>::infinity();
 }
 
-// floor(value) clamped to [0, count - 1] before the cast (NaN gives 0): no overflow.
-int ClampedIndex(double value, int count) {
-  const double f = std::floor(value);
-  if (!(f > 0.0)) return 0;
-  return f >= count - 1 ? count - 1 : static_cast<int>(f);
-}
-
 }  // namespace
 
 SegmentGrid::SegmentGrid(std::vector<Segment2> segments, double min_cell)
@@ -75,14 +68,6 @@ SegmentGrid::SegmentGrid(std::vector<Segment2> segments, double min_cell)
 bool SegmentGrid::ClipToGrid(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double* t0,
                              double* t1) const {
   return ClipToBox(a, b, origin_, origin_ + cell_ * Eigen::Vector2d(cols_, rows_), t0, t1);
-}
-
-int SegmentGrid::Col(double x) const {
-  return ClampedIndex((x - origin_.x()) / cell_, cols_);
-}
-
-int SegmentGrid::Row(double y) const {
-  return ClampedIndex((y - origin_.y()) / cell_, rows_);
 }
 
 void SegmentGrid::BandExtent(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double y0,

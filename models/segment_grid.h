@@ -38,6 +38,16 @@ class SegmentGrid {
     });
   }
 
+  // As Along, without the marks that visit each segment once: a segment registered in several
+  // cells on the way is visited once per cell. Safe to call from several threads at once.
+  template <typename Visit>
+  bool AlongEveryCell(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      const Visit& visit) const {
+    return Walk(a, b, [&](size_t cell) {
+      return std::any_of(cells_[cell].begin(), cells_[cell].end(), visit);
+    });
+  }
+
   // Calls visit(i) once for each segment registered in a cell that the convex polygon `ring`,
   // grown by `margin` metres, meets (a superset of the segments within `margin` of it).
   template <typename Visit>
@@ -73,8 +83,14 @@ class SegmentGrid {
                   double max_t) const;
 
  private:
-  int Col(double x) const;
-  int Row(double y) const;
+  // floor(value) clamped to [0, count - 1] before the cast (NaN gives 0): no overflow.
+  static int ClampedIndex(double value, int count) {
+    const double f = std::floor(value);
+    if (!(f > 0.0)) return 0;
+    return f >= count - 1 ? count - 1 : static_cast<int>(f);
+  }
+  int Col(double x) const { return ClampedIndex((x - origin_.x()) / cell_, cols_); }
+  int Row(double y) const { return ClampedIndex((y - origin_.y()) / cell_, rows_); }
   // Calls visit(cell) for the cells segment a -> b passes through, from a (Amanatides-Woo);
   // stops when visit returns true (and returns true then).
   template <typename Visit>

@@ -206,6 +206,8 @@ ViewInvariantRegions ViewInvariantRegions::Build(const WireframeModel& model,
     vir.footprints_.push_back({footprint.front(), footprint.back()});
   }
   vir.storeys_ = area.storeys();
+  vir.hidden_margin_ = options.hidden_margin;
+  vir.storey_walls_.resize(area.storeys().size());
   for (int s = 0; s < static_cast<int>(area.storeys().size()); ++s)
     vir.BuildStorey(model, area, s, options);
   vir.BuildGrid(area);
@@ -272,6 +274,12 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   occluders.solid_sides = SegmentGrid(std::move(sides));
   occluders.seen.assign(occluders.solids.size(), 0);
   occluders_.insert(occluders_.end(), walls.begin(), walls.end());
+  StoreyWalls& own = storey_walls_[s];
+  own.grid = occluders.walls;
+  own.lines = occluders.wall_lines;
+  own.hideable.assign(model.edges().size(), 0);
+  for (size_t k = 0; k < edges.ids.size(); ++k)
+    own.hideable[edges.ids[k]] = edges.in_band[k];
   // The initial cells' lists first; a region split from one tests only its cell's list. A cell
   // split into many regions keeps each edge's occluders for them.
   std::vector<int> regions_of(initial.size(), 0);

@@ -10,20 +10,24 @@
 #include <vector>
 
 #include "models/camera.h"
+#include "models/convex_polygon.h"
 #include "models/navigable_area.h"
+#include "models/segment_grid.h"
 #include "models/wireframe.h"
 
 namespace linetrack {
 
-// One model edge in a region's visibility list. Bearings are world angles (radians,
-// counter-clockwise from +x) of the directions from points of the region to points of the edge,
-// projected on the floor plane: the interval [bearing_min, bearing_max] (bearing_max may exceed
-// pi; width < 2 pi) unless all_bearings (the edge passes over the region).
+// One model edge in a region's visibility list. Bearings are world angles (counter-clockwise from
+// +x) of the directions from points of the region to points of the edge, projected on the floor
+// plane, held as diamond angles (DiamondAngle, models/geometry.h: monotone in the bearing, no
+// transcendental function): the arc [diamond_min, diamond_max] (diamond_min in [0, 4),
+// diamond_max - diamond_min < 2, a half turn) unless all_bearings (the edge passes over the
+// region).
 struct RegionEdge {
   int edge_id = -1;
-  double bearing_min = 0.0;
-  double bearing_max = 0.0;
   bool all_bearings = false;
+  double diamond_min = 0.0;
+  double diamond_max = 0.0;
 };
 
 // A convex cell of the navigable area on one storey and its visibility list (sorted by edge id).
@@ -101,7 +105,8 @@ class ViewInvariantRegions {
   // Edges possibly visible from the query (sorted ids, each once): the union of the visibility
   // lists of the regions of the camera's storey meeting the disk, keeping an edge when its bearing
   // range meets [heading - margin - half_width, heading + margin + half_width], and so do the
-  // bearings from the disk itself to the edge. Conservative: an edge that ray casting finds visible
+  // bearings from the disk itself to the edge, and the storey's walls do not hide from the disk
+  // the part of the edge under those bearings. Conservative: an edge that ray casting finds visible
   // from a pose inside the query (position in the navigable area, camera height between the model's
   // floor and top) is never missing. Throws InputError on a non-finite or negative field.
   std::vector<int> Query(const VisibilityQuery& query) const;
@@ -118,7 +123,21 @@ class ViewInvariantRegions {
   void BuildStorey(const WireframeModel& model, const NavigableArea& area, int s,
                    const ViewInvariantRegionsOptions& options);
 
+  // True when, seen from anywhere in the query's disk, the storey's walls hide every point of the
+  // edge's footprint under the query's bearings (half: the bearings' half-width, radians).
+  bool HiddenFromDisk(const VisibilityQuery& query, double half, int storey, int edge_id) const;
+
+  // Per storey, its occluding walls (with their lines) and per model edge whether they can hide
+  // it (an edge within the storey's band of camera heights).
+  struct StoreyWalls {
+    SegmentGrid grid = SegmentGrid({});
+    std::vector<Line2> lines;
+    std::vector<char> hideable;
+  };
+
   std::vector<ViewRegion> regions_;
+  std::vector<StoreyWalls> storey_walls_;
+  double hidden_margin_ = 1e-3;  // ViewInvariantRegionsOptions::hidden_margin
   std::vector<Storey> storeys_;
   std::vector<Segment2> occluders_;
   std::vector<Polygon2> solids_;

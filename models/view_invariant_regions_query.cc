@@ -9,6 +9,7 @@
 #include "models/convex_polygon.h"
 #include "models/errors.h"
 #include "models/free_space.h"
+#include "models/plan_visibility.h"
 #include "models/robot_pose.h"
 #include "models/text_format.h"
 #include "models/view_invariant_regions.h"
@@ -16,11 +17,15 @@
 namespace linetrack {
 namespace {
 
+// Arcs of bearings (radians) or of diamond angles this close count as meeting: far above the
+// rounding of their ends, and a diamond angle grows at most as fast as the bearing.
+constexpr double kArcSlack = 1e-12;
+
 // True when the arcs [centre_a +- half_a] and [centre_b +- half_b] (radians) meet modulo 2 pi.
 bool ArcsMeet(double centre_a, double half_a, double centre_b, double half_b) {
   double d = centre_a - centre_b;
   d -= 2.0 * kPi * std::floor(d / (2.0 * kPi) + 0.5);  // to [-pi, pi), cheaper than remainder
-  return std::abs(d) <= half_a + half_b + 1e-12;
+  return std::abs(d) <= half_a + half_b + kArcSlack;
 }
 
 // Bearings of q - p for q on the footprint and p in the disk (centre, radius), as an arc
@@ -114,6 +119,9 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
       std::isfinite(query.camera_z) && !storeys_.empty() ? StoreyAt(storeys_, query.camera_z) : -1;
   const double half = query.heading_margin + query.bearing_half_width;
   const bool any_bearing = half >= kPi;
+  // The query's bearings [heading - half, heading + half] as an arc of diamond angles.
+  const double query_min = BearingToDiamond(query.heading - half);
+  const double query_width = WrapDiamond(BearingToDiamond(query.heading + half) - query_min);
   // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
   std::vector<char> state(num_edges_, 0);
   for (int r : candidates) {
@@ -126,21 +134,51 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
         state[e.edge_id] = 1;
         continue;
       }
-      if (!e.all_bearings &&
-          !ArcsMeet(0.5 * (e.bearing_min + e.bearing_max), 0.5 * (e.bearing_max - e.bearing_min),
-                    query.heading, half)) {
+      if (!e.all_bearings && !DiamondArcsMeet(e.diamond_min, e.diamond_max - e.diamond_min,
+                                              query_min, query_width, kArcSlack)) {
         continue;  // another region may still see it under the query's bearings
       }
       double arc_centre = 0.0, arc_half = 0.0;
       const bool narrow =
           DiskBearings(footprints_[e.edge_id], query.centre, query.radius, &arc_centre, &arc_half);
-      state[e.edge_id] = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half) ? 1 : 2;
+      const bool seen = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half);
+      state[e.edge_id] = seen && !HiddenFromDisk(query, half, storey, e.edge_id) ? 1 : 2;
     }
   }
   for (int id = 0; id < num_edges_; ++id) {
     if (state[id] == 1) ids.push_back(id);
   }
   return ids;
+}
+
+bool ViewInvariantRegions::HiddenFromDisk(const VisibilityQuery& query, double half, int storey,
+                                          int edge_id) const {
+  // A piece of the footprint this short is not split further (metres); at most 2^kMaxDepth pieces.
+  constexpr double kMinPiece = 0.05;
+  constexpr int kMaxDepth = 3;
+  if (storey < 0 || storey >= static_cast<int>(storey_walls_.size())) return false;
+  const StoreyWalls& walls = storey_walls_[storey];
+  if (walls.hideable.empty() || !walls.hideable[edge_id]) return false;
+  Segment2 part;
+  if (!ClipToBearingWedge(footprints_[edge_id], query.centre, query.radius, query.heading, half,
+                          &part)) {
+    return true;  // no point of the edge under the query's bearings
+  }
+  const Ring2 disk = PolygonAroundDisk(query.centre, query.radius, 8);
+  // A piece is hidden when one wall hides it from the whole disk (such a wall crosses the sight
+  // line to its middle); the edge when every piece is, the pieces halved where one is not.
+  const auto hidden = [&](const Segment2& piece, int depth, const auto& self) -> bool {
+    const Ring2 footprint = piece.Length() > 0.0 ? Ring2{piece.a, piece.b} : Ring2{piece.a};
+    const bool by_wall = walls.grid.AlongEveryCell(query.centre, piece.Mid(), [&](int i) {
+      return HiddenByWall(disk, footprint, walls.grid.segments()[i], walls.lines[i],
+                          hidden_margin_);
+    });
+    if (by_wall) return true;
+    if (depth >= kMaxDepth || piece.Length() < 2.0 * kMinPiece) return false;
+    return self({piece.a, piece.Mid()}, depth + 1, self) &&
+           self({piece.Mid(), piece.b}, depth + 1, self);
+  };
+  return hidden(part, 0, hidden);
 }
 
 std::string ViewInvariantRegions::ExplainEmptyQuery(const VisibilityQuery& query) const {

@@ -45,18 +45,38 @@ Eigen::Vector2d Centre(const Ring2& footprint) {
   return to;
 }
 
+// The walls that last hid an edge from one region: the next edges (of the same face, the same
+// room) are often hidden by the same walls, found without walking their sight lines.
+struct RecentWalls {
+  static constexpr int kSize = 4;
+  std::array<int, kSize> ids{-1, -1, -1, -1};
+  int next = 0;
+};
+
 // True when an occluder or a solid hides the whole footprint from the whole region: only those
-// crossing the line between their centres can (docs/models.md).
+// crossing the line between their centres can (docs/models.md). The walls of `recent` that cross
+// it are tried first, and a wall that hides the footprint joins them.
 bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footprint,
-            const StoreyOccluders& o, double margin) {
+            const StoreyOccluders& o, double margin, RecentWalls* recent) {
   const Eigen::Vector2d to = Centre(footprint);
-  int crossed = 0;
   const double sight_length = (to - from).norm();
+  const auto hides = [&](int i) {
+    const Segment2& wall = o.walls.segments()[i];
+    return SegmentsMeet(from, to, sight_length, wall, o.wall_lengths[i]) &&
+           HiddenByWall(region, footprint, wall, o.wall_lines[i], margin);
+  };
+  for (int i : recent->ids) {
+    if (i >= 0 && hides(i)) return true;
+  }
+  int crossed = 0;
   const bool by_wall = o.walls.Along(from, to, [&](int i) {
     const Segment2& wall = o.walls.segments()[i];
     if (!SegmentsMeet(from, to, sight_length, wall, o.wall_lengths[i])) return false;
     ++crossed;
-    return HiddenByWall(region, footprint, wall, margin);
+    if (!HiddenByWall(region, footprint, wall, o.wall_lines[i], margin)) return false;
+    recent->ids[recent->next] = i;
+    recent->next = (recent->next + 1) % RecentWalls::kSize;
+    return true;
   });
   if (by_wall) return true;
   // The sight line between the centres is clear: the footprint is in sight. (A solid's sides are
@@ -112,25 +132,26 @@ bool MaybeBehindItsFaces(const ModelEdge& edge, const Ring2& cell, const Wirefra
   });
 }
 
-// Counter-clockwise convex hull of the points (Andrew's monotone chain).
-Ring2 Hull(Ring2 points) {
-  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+// Counter-clockwise convex hull of `points` (Andrew's monotone chain; sorts them) into `hull`,
+// whose storage is reused.
+void Hull(Ring2* points, Ring2* hull) {
+  std::sort(points->begin(), points->end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
   });
-  Ring2 hull(2 * points.size());
+  Ring2& h = *hull;
+  h.resize(2 * points->size());
   size_t k = 0;
   for (size_t pass = 0; pass < 2; ++pass) {
     const size_t start = k;
-    for (const Eigen::Vector2d& p : points) {
-      while (k >= start + 2 && Cross2(hull[k - 1] - hull[k - 2], p - hull[k - 2]) <= 0.0)
+    for (const Eigen::Vector2d& p : *points) {
+      while (k >= start + 2 && Cross2(h[k - 1] - h[k - 2], p - h[k - 2]) <= 0.0)
         --k;
-      hull[k++] = p;
+      h[k++] = p;
     }
     --k;  // the last point starts the other chain
-    std::reverse(points.begin(), points.end());
+    std::reverse(points->begin(), points->end());
   }
-  hull.resize(std::max<size_t>(k, 1));
-  return hull;
+  h.resize(std::max<size_t>(k, 1));
 }
 
 // A convex polygon of a few vertices, on the stack.
@@ -168,17 +189,17 @@ struct HullAxes {
   std::vector<std::pair<Eigen::Vector2d, double>> normals;  // n and n.(a vertex of its edge)
 };
 
-HullAxes AxesOf(Ring2 hull) {
-  HullAxes axes{std::move(hull), {}};
-  const Ring2& h = axes.hull;
+// Fills axes->normals from axes->hull.
+void ComputeAxes(HullAxes* axes) {
+  const Ring2& h = axes->hull;
+  axes->normals.clear();
   for (size_t i = 0; i < h.size(); ++i) {
     const Eigen::Vector2d e = h[(i + 1) % h.size()] - h[i];
     const double length = e.norm();
     if (length == 0.0) continue;
     const Eigen::Vector2d n = Eigen::Vector2d(e.y(), -e.x()) / length;
-    axes.normals.emplace_back(n, n.dot(h[i]));
+    axes->normals.emplace_back(n, n.dot(h[i]));
   }
-  return axes;
 }
 
 // SegmentNearConvex with the ring's axes computed once.
@@ -199,12 +220,15 @@ bool SegmentNearHull(const HullAxes& axes, const Segment2& s, double tolerance) 
 }
 
 // The occluders of `footprint` for the cell `ring` (CellList), appended to `out`.
+// `points` and `axes` are scratch storage, reused from call to call.
 void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const StoreyOccluders& o,
-                          double margin, std::vector<CellOccluder>* out) {
-  Ring2 points = ring;
-  points.insert(points.end(), footprint.begin(), footprint.end());
-  const HullAxes axes = AxesOf(Hull(std::move(points)));
-  const Ring2& hull = axes.hull;
+                          double margin, Ring2* points, HullAxes* axes,
+                          std::vector<CellOccluder>* out) {
+  points->assign(ring.begin(), ring.end());
+  points->insert(points->end(), footprint.begin(), footprint.end());
+  Hull(points, &axes->hull);
+  ComputeAxes(axes);
+  const Ring2& hull = axes->hull;
   Eigen::Vector2d lo = ring.front(), hi = lo;
   for (const Eigen::Vector2d& p : ring)
     lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -218,7 +242,7 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
       f_hi = std::max(f_hi, line.SignedDistance(f));
     }
     if (f_hi > -margin && f_lo < margin) return;
-    if (!SegmentNearHull(axes, wall, kHullTolerance)) return;
+    if (!SegmentNearHull(*axes, wall, kHullTolerance)) return;
     Eigen::Vector2d s_lo, s_hi;
     if (ShadowBox(ring, footprint, wall, line, kHullTolerance, &s_lo, &s_hi))
       out->push_back(Occluder(i, s_lo, s_hi));
@@ -227,7 +251,7 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
   o.solid_sides.InConvex(hull, kHullTolerance, [&](int side) {
     const int solid = o.solid_of_side[side];
     if (o.seen[solid] == o.test) return;
-    if (!SegmentNearHull(axes, o.solid_sides.segments()[side], kHullTolerance)) return;
+    if (!SegmentNearHull(*axes, o.solid_sides.segments()[side], kHullTolerance)) return;
     o.seen[solid] = o.test;
     out->push_back(Occluder(-1 - solid, lo, hi));
   });
@@ -236,7 +260,9 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
 }  // namespace
 
 bool SegmentNearConvex(const Ring2& ring, const Segment2& s, double tolerance) {
-  return SegmentNearHull(AxesOf(ring), s, tolerance);
+  HullAxes axes{ring, {}};
+  ComputeAxes(&axes);
+  return SegmentNearHull(axes, s, tolerance);
 }
 
 bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, const Line2& line,
@@ -282,14 +308,17 @@ CellList CellVisibility(const Ring2& ring, const WireframeModel& model, const St
   CellList list;
   if (keep == CellOccluders::kKeep) list.first.push_back(0);
   const Eigen::Vector2d centre = RingCentroid(ring);
+  Ring2 points;
+  HullAxes axes;
+  RecentWalls recent;
   for (size_t k = 0; k < edges.ids.size(); ++k) {
     const ModelEdge& edge = model.edges()[edges.ids[k]];
     if (BehindItsFaces(edge, ring, model, edges, margin)) continue;
     const Ring2& footprint = edges.footprints[k];
     if (edges.in_band[k]) {
-      if (Hidden(ring, centre, footprint, occluders, margin)) continue;
+      if (Hidden(ring, centre, footprint, occluders, margin, &recent)) continue;
       if (keep == CellOccluders::kKeep)
-        OccludersOfFootprint(ring, footprint, occluders, margin, &list.occluders);
+        OccludersOfFootprint(ring, footprint, occluders, margin, &points, &axes, &list.occluders);
     }
     list.edges.push_back(static_cast<int>(k));
     if (keep == CellOccluders::kKeep) {
@@ -317,6 +346,7 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
   const Ring2& ring = region.ring;
   const Eigen::Vector2d centroid = RingCentroid(ring);
   const bool walk = cell.first.empty();
+  RecentWalls recent;
   for (size_t j = 0; j < cell.edges.size(); ++j) {
     const int k = cell.edges[j];
     const ModelEdge& edge = model.edges()[edges.ids[k]];
@@ -335,14 +365,18 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
                        : HiddenBySolid(ring, footprint, occluders.solids[-1 - o.id], margin);
     };
     if (edges.in_band[k]) {
-      if (walk && Hidden(ring, centroid, footprint, occluders, margin)) continue;
+      if (walk && Hidden(ring, centroid, footprint, occluders, margin, &recent)) continue;
       if (!walk && std::any_of(cell.occluders.data() + cell.first[j],
                                cell.occluders.data() + cell.first[j + 1], hides)) {
         continue;
       }
     }
-    const BearingRange range = BearingsToFootprint(ring, footprint, centroid);
-    visible.push_back({edge.id, range.min, range.max, range.all});
+    const BearingRange range = BearingsToFootprint(ring, region.lo, region.hi, footprint);
+    RegionEdge& listed = visible.emplace_back();
+    listed.edge_id = edge.id;
+    listed.all_bearings = range.all;
+    listed.diamond_min = range.min;
+    listed.diamond_max = range.max;
   }
   return visible;
 }

@@ -2,6 +2,7 @@
 // against each of its rooms modelled alone: the regions' build time and memory, localisation
 // per room under the paper's priors (QI1-3), and the localize median of both.
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <array>
@@ -39,6 +40,13 @@ double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+// CPU time of the process (all its threads, user + system), seconds.
+double ProcessCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 double MaxRssMb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -52,6 +60,7 @@ struct Setup {
   std::unique_ptr<ViewInvariantRegions> regions;
   std::unique_ptr<Localizer> localizer;
   double regions_ms = 0.0;
+  double regions_cpu_ms = 0.0;  // CPU time of the build, all threads
 };
 
 Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera) {
@@ -59,24 +68,33 @@ Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera) {
   s.model = std::make_unique<WireframeModel>(WireframeModel::FromCao(cao));
   s.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*s.model));
   const Clock::time_point start = Clock::now();
+  const double cpu_start = ProcessCpuSeconds();
   s.regions =
       std::make_unique<ViewInvariantRegions>(ViewInvariantRegions::Build(*s.model, *s.area));
+  s.regions_cpu_ms = 1e3 * (ProcessCpuSeconds() - cpu_start);
   s.regions_ms = MsSince(start);
   s.localizer = std::make_unique<Localizer>(*s.model, s.regions.get(), s.area.get(), camera);
   return s;
 }
 
-// Correct answers of `count` scenes drawn in `sampling` (poses on `storey`), and the localize
-// times (milliseconds) appended to `times`.
+// The localize times (milliseconds) and candidate edges of a series of scenes.
+struct LocalizeCosts {
+  std::vector<double> times;
+  std::vector<double> candidates;
+};
+
+// Correct answers of `count` scenes drawn in `sampling` (poses on `storey`), their costs appended
+// to `costs`.
 int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticSceneOptions o,
-                   std::vector<double>* times) {
+                   LocalizeCosts* costs) {
   const std::vector<SyntheticScene> scenes = GenerateScenes(*setup.model, sampling, o);
   int correct = 0;
   for (const SyntheticScene& scene : scenes) {
     const LocalizationProblem problem = ProblemOf(scene);
     const Clock::time_point start = Clock::now();
     const LocalizationResult result = setup.localizer->Localize(problem);
-    times->push_back(MsSince(start));
+    costs->times.push_back(MsSince(start));
+    costs->candidates.push_back(result.candidate_edges);
     correct += JudgeScene(scene, result) == MatchOutcome::kCorrect ? 1 : 0;
   }
   return correct;
@@ -107,14 +125,15 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
   std::snprintf(
       line, sizeof(line),
       "building: %d storeys, %d rooms, %zu edges, %zu faces; navigable area %.1f m2 in "
-      "%zu parts\nregions: %d built in %.0f ms, peak memory +%.0f MB (process %.0f MB)\n\n",
+      "%zu parts\nregions: %d built in %.0f ms (CPU %.0f ms, all threads), peak memory +%.0f MB "
+      "(process %.0f MB)\n\n",
       opt.spec.storeys, rooms, whole.model->edges().size(), whole.model->faces().size(),
       whole.area->Area(), whole.area->parts().size(), whole.regions->size(), whole.regions_ms,
-      std::max(0.0, rss_after - rss_before), rss_after);
+      whole.regions_cpu_ms, std::max(0.0, rss_after - rss_before), rss_after);
   out << line
       << "| room | QI1 building | QI1 alone | QI2 building | QI2 alone | QI3 building | "
          "QI3 alone |\n| --- | --- | --- | --- | --- | --- | --- |\n";
-  std::vector<double> times_building, times_alone;
+  LocalizeCosts building_costs, alone_costs;
   std::array<int, 3> sum_building{}, sum_alone{};
   int done = 0;
   for (size_t k = 0; k < building.spaces.size(); ++k) {
@@ -133,9 +152,9 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
       o.delta_phi = bounds.delta_phi;
       o.floor_z = room.floor_z;
       o.storey = room.storey;
-      const int b = CorrectAnswers(whole, sampling, o, &times_building);
+      const int b = CorrectAnswers(whole, sampling, o, &building_costs);
       o.storey = 0;
-      const int a = CorrectAnswers(alone, *alone.area, o, &times_alone);
+      const int a = CorrectAnswers(alone, *alone.area, o, &alone_costs);
       sum_building[qi - 1] += b;
       sum_alone[qi - 1] += a;
       out << " | " << b << " | " << a;
@@ -147,11 +166,14 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
   out << "| **all** ";
   for (int qi = 0; qi < 3; ++qi)
     out << "| **" << sum_building[qi] << "** | **" << sum_alone[qi] << "** ";
+  const double t_building = Median(building_costs.times), t_alone = Median(alone_costs.times);
   std::snprintf(line, sizeof(line),
                 "|\n\ncorrect of %d scenes per room and prior (seed %llu)\nlocalize median: "
-                "building %.3f ms, rooms alone %.3f ms (x %.2f)\n",
-                opt.count, static_cast<unsigned long long>(opt.seed), Median(times_building),
-                Median(times_alone), Median(times_building) / std::max(1e-9, Median(times_alone)));
+                "building %.3f ms, rooms alone %.3f ms (x %.2f)\ncandidate edges median: "
+                "building %.0f, rooms alone %.0f\n",
+                opt.count, static_cast<unsigned long long>(opt.seed), t_building, t_alone,
+                t_building / std::max(1e-9, t_alone), Median(building_costs.candidates),
+                Median(alone_costs.candidates));
   out << line;
   std::cout << out.str();
   if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, out.str());

@@ -195,23 +195,79 @@ TEST(PlanVisibility, BearingRangeHoldsEverySampledBearingAndIsTight) {
                              f0 + Eigen::Vector2d(2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0)};
     const BearingRange range = BearingsToFootprint(region, footprint);
     if (range.all) continue;
-    EXPECT_GT(range.min, -kPi);
-    EXPECT_LE(range.min, kPi);
-    EXPECT_LT(range.max - range.min, kPi);
+    EXPECT_GE(range.min, 0.0);
+    EXPECT_LT(range.min, 4.0);
+    EXPECT_GE(range.max, range.min);
+    EXPECT_LT(range.max - range.min, 2.0);
+    // The diamond arc as bearings (radians): [lo, lo + width].
+    const double lo = DiamondToBearing(range.min);
+    double width = DiamondToBearing(range.max) - lo;
+    width -= 2.0 * kPi * std::floor(width / (2.0 * kPi));
+    if (width > 1.5 * kPi) width = 0.0;  // a zero-width arc whose end rounded below its start
+    EXPECT_LT(width, kPi);
     double widest = 0.0;
     for (int k = 0; k < 300; ++k) {
       const Eigen::Vector2d v =
           footprint[0] + unit(rng) * (footprint[1] - footprint[0]) - PointIn(region, &rng);
       const double b = std::atan2(v.y(), v.x());
-      const double from_min = b - range.min - 2.0 * kPi * std::floor((b - range.min) / (2.0 * kPi));
-      EXPECT_LE(from_min, range.max - range.min + kTol) << "trial " << trial;
+      const double from_min = b - lo - 2.0 * kPi * std::floor((b - lo) / (2.0 * kPi));
+      EXPECT_LE(from_min, width + kTol) << "trial " << trial;
       widest = std::max(widest, from_min);
     }
-    EXPECT_GT(widest, 0.8 * (range.max - range.min));  // not needlessly wide
+    EXPECT_GT(widest, 0.8 * width);  // not needlessly wide
   }
   // A footprint touching the region is seen under every bearing.
   EXPECT_TRUE(BearingsToFootprint(Box(0, 0, 1, 1), {{1.0, 0.5}, {2.0, 0.5}}).all);
   EXPECT_TRUE(BearingsToFootprint(Box(0, 0, 1, 1), {{0.5, 0.5}}).all);
+}
+
+// Every point of the footprint seen from a point of the disk under a bearing of the arc lies in
+// the clipped part, which is part of the footprint.
+TEST(PlanVisibility, BearingWedgeKeepsEveryPointSeenUnderTheArc) {
+  std::mt19937 rng(31u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int seen = 0, clipped = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Eigen::Vector2d centre(4.0 * unit(rng) - 2.0, 4.0 * unit(rng) - 2.0);
+    const double radius = 0.1 + unit(rng), heading = 2.0 * kPi * unit(rng);
+    const double half = 1.6 * unit(rng);
+    const Segment2 footprint{{10.0 * unit(rng) - 5.0, 10.0 * unit(rng) - 5.0},
+                             {10.0 * unit(rng) - 5.0, 10.0 * unit(rng) - 5.0}};
+    Segment2 part;
+    const bool any = ClipToBearingWedge(footprint, centre, radius, heading, half, &part);
+    if (any) {
+      EXPECT_LT(DistanceToSegment(part.a, footprint), kTol);
+      EXPECT_LT(DistanceToSegment(part.b, footprint), kTol);
+      clipped += part.Length() < footprint.Length() - kTol ? 1 : 0;
+    }
+    for (int k = 0; k < 200; ++k) {
+      const double r = radius * std::sqrt(unit(rng)), a = 2.0 * kPi * unit(rng);
+      const Eigen::Vector2d eye = centre + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const Eigen::Vector2d p = footprint.a + unit(rng) * (footprint.b - footprint.a);
+      const double bearing = std::atan2(p.y() - eye.y(), p.x() - eye.x());
+      if (std::abs(WrapAngle(bearing - heading)) > half) continue;
+      ++seen;
+      ASSERT_TRUE(any) << "trial " << trial;
+      EXPECT_LT(DistanceToSegment(p, part), kTol) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(seen, 1000);   // points under the arc are tested
+  EXPECT_GT(clipped, 50);  // and the clip does cut footprints
+}
+
+TEST(PlanVisibility, PolygonAroundDiskHoldsTheDisk) {
+  for (int sides : {3, 8, 13}) {
+    const Eigen::Vector2d centre(1.5, -2.0);
+    const Ring2 ring = PolygonAroundDisk(centre, 0.7, sides);
+    ASSERT_EQ(ring.size(), static_cast<size_t>(sides));
+    EXPECT_GT(RingSignedArea(ring), 0.0);
+    for (int k = 0; k < 360; ++k) {
+      const double a = DegToRad(k);
+      EXPECT_TRUE(
+          ConvexContains(ring, centre + 0.7 * Eigen::Vector2d(std::cos(a), std::sin(a)), 0.0))
+          << sides << " sides, " << k << " deg";
+    }
+  }
 }
 
 }  // namespace

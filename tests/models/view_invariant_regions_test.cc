@@ -162,10 +162,10 @@ TEST_P(RegionsPartition, TheNavigableArea) {
     }
     for (const RegionEdge& e : region.visible) {
       if (e.all_bearings) continue;
-      EXPECT_GT(e.bearing_min, -kPi);
-      EXPECT_LE(e.bearing_min, kPi);
-      EXPECT_GE(e.bearing_max, e.bearing_min);
-      EXPECT_LT(e.bearing_max - e.bearing_min, kPi);
+      EXPECT_GE(e.diamond_min, 0.0);
+      EXPECT_LT(e.diamond_min, 4.0);
+      EXPECT_GE(e.diamond_max, e.diamond_min);
+      EXPECT_LT(e.diamond_max - e.diamond_min, 2.0);
     }
   }
   EXPECT_NEAR(total, b.area.Area(), kAreaTolM2);
@@ -198,8 +198,8 @@ void ExpectSameRegions(const ViewInvariantRegions& a, const ViewInvariantRegions
     ASSERT_EQ(x.visible.size(), y.visible.size()) << r;
     for (size_t k = 0; k < x.visible.size(); ++k) {
       EXPECT_EQ(x.visible[k].edge_id, y.visible[k].edge_id);
-      EXPECT_EQ(x.visible[k].bearing_min, y.visible[k].bearing_min);
-      EXPECT_EQ(x.visible[k].bearing_max, y.visible[k].bearing_max);
+      EXPECT_EQ(x.visible[k].diamond_min, y.visible[k].diamond_min);
+      EXPECT_EQ(x.visible[k].diamond_max, y.visible[k].diamond_max);
       EXPECT_EQ(x.visible[k].all_bearings, y.visible[k].all_bearings);
     }
   }
