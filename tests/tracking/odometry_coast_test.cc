@@ -219,9 +219,11 @@ TEST(OdometryCoast, ContradictingPosesAreFoundAndTheirUnionCoversBoth) {
   // The truth may be anywhere within b's level of the far pose.
   EXPECT_NEAR(u.protection_position_m, 0.14 + 0.08, kExactTol);
   EXPECT_GE(u.sigma_x_m, 0.14);
-  EXPECT_TRUE(PreferCoasted(a, b) == false);
+  EXPECT_FALSE(PreferCoasted(a, b));  // both tracking: the image pose
   a.status = IntegrityStatus::kDegraded;
   EXPECT_TRUE(PreferCoasted(a, b));
+  b.status = IntegrityStatus::kDegraded;
+  EXPECT_FALSE(PreferCoasted(a, b));
 }
 
 TEST(OdometryCoast, OptionsAreChecked) {

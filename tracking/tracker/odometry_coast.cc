@@ -170,10 +170,7 @@ PoseUncertainty UnionOfContradicting(const PoseUncertainty& reported, const Pose
 }
 
 bool PreferCoasted(const PoseUncertainty& image, const PoseUncertainty& coasted) {
-  const bool image_ok = image.status == IntegrityStatus::kTracking;
-  const bool coasted_ok = coasted.status == IntegrityStatus::kTracking;
-  if (image_ok != coasted_ok) return coasted_ok;
-  return coasted.protection_position_m < image.protection_position_m;
+  return coasted.status == IntegrityStatus::kTracking && image.status != IntegrityStatus::kTracking;
 }
 
 }  // namespace linetrack

@@ -112,8 +112,9 @@ PoseDisagreement Disagreement(const Eigen::Isometry3d& a, const PoseUncertainty&
 PoseUncertainty UnionOfContradicting(const PoseUncertainty& reported, const PoseUncertainty& other,
                                      const PoseDisagreement& disagreement, const std::string& why);
 
-// Whether the coasted pose is reported rather than the image's (both valid bounds, union): the one
-// within the alert limits, else the one with the smaller position level.
+// Whether the coasted pose is reported rather than the image's (both valid bounds, union): only
+// when it is within the alert limits and the image pose is not. Otherwise the image pose, fresh
+// from this frame, is reported (a coasted level only grows: it never helps a later frame more).
 bool PreferCoasted(const PoseUncertainty& image, const PoseUncertainty& coasted);
 
 }  // namespace linetrack
