@@ -528,6 +528,7 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   const std::optional<CoastedPose> coasted = CoastToFrame(robot);
   if (following_) {
     Follow(t, robot, &report);
+    WithholdUnconfirmedGlobal(&report);
     Combine(robot, coasted, &report);
     report.total_ms = MillisecondsSince(start);
     return report;
@@ -572,9 +573,22 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     report.cam_from_world.reset();
     report.uncertainty.reason = report.note;
   }
+  WithholdUnconfirmedGlobal(&report);
   Combine(robot, coasted, &report);
   report.total_ms = MillisecondsSince(start);
   return report;
+}
+
+void SequenceTracker::WithholdUnconfirmedGlobal(FrameReport* report) const {
+  if (!reacquisition_ || !reacquisition_->global || !report->cam_from_world) return;
+  report->cam_from_world.reset();
+  PoseUncertainty& u = report->uncertainty;
+  const std::string was = u.reason;
+  u = PoseUncertainty();
+  u.status = IntegrityStatus::kLost;
+  u.reason =
+      "a global re-localisation is reported once confirmed" + (was.empty() ? "" : ": " + was);
+  report->note = u.reason;
 }
 
 std::optional<CoastedPose> SequenceTracker::CoastToFrame(

@@ -223,6 +223,9 @@ class SequenceTracker {
   // The image pose checked against the coasted one (a contradiction degrades it), or the coasted
   // pose reported when there is no image pose or it bounds the pose better; then the anchor the
   // next frame coasts from.
+  // A global pose not yet confirmed is not reported: nothing before it bounds a wrong answer (a
+  // twin corridor), so its covariance would not cover one. The tracker still follows it.
+  void WithholdUnconfirmedGlobal(FrameReport* report) const;
   void Combine(const std::optional<RobotReading>& robot, const std::optional<CoastedPose>& coasted,
                FrameReport* report);
 
