@@ -468,13 +468,6 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
     MaybeSwitchToGlobal(*robot);
     if (global_mode_) return TryGlobal(t, *robot, report) ? "global" : nullptr;
   }
-  // The coasted pose is where the last reported pose is now: restart there first.
-  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
-  std::string restart_note;
-  if (options_.restart_from_last_good && coasting) {
-    if (StartAndVerify(coasted->cam_from_world, t, robot, report)) return "restart";
-    restart_note = report->note;
-  }
   if (relocalizer_ && robot) {
     RobotPose prior;
     SearchBounds bounds;
@@ -497,13 +490,25 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
       report->note = "no prior for the matcher";
     }
   }
-  if (options_.restart_from_last_good && !coasting && last_good_ &&
-      FramesSinceGood() <= options_.restart_window) {
+  if (global_mode_) return nullptr;  // the matcher's pose had a rival
+  // A restart from where the odometry carries the last reported pose, else from the last good
+  // pose; the carried one is checked for a rival as the matcher's is (a robot carried to a place
+  // that looks the same holds the carried pose on the image).
+  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
+  std::optional<Eigen::Isometry3d> restart;
+  if (coasting) {
+    restart = coasted->cam_from_world;
+  } else if (last_good_ && FramesSinceGood() <= options_.restart_window) {
+    restart = last_good_->cam_from_world;
+  }
+  if (options_.restart_from_last_good && restart) {
     const std::string matcher_note = report->note;
-    if (StartAndVerify(last_good_->cam_from_world, t, robot, report)) return "restart";
+    if (StartAndVerify(*restart, t, robot, report)) {
+      return coasting && robot && HasRival(*report->cam_from_world, *robot, report) ? nullptr
+                                                                                    : "restart";
+    }
     if (!matcher_note.empty()) report->note = matcher_note + "; restart: " + report->note;
   }
-  if (!restart_note.empty()) report->note += "; restart: " + restart_note;
   if (!start_pose_ && !(relocalizer_ && robot) && !last_good_) {
     report->note = "no start pose and no prior";
   }
