@@ -481,6 +481,7 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
       } else if (attempt.lines >= options_.global.kidnap_min_lines) {
         ++failed_searches_;
       }
+      image_allows_coasting_ = attempt.found || attempt.lines < options_.global.kidnap_min_lines;
       if (!attempt.found) {
         report->note = attempt.reason;
       } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
@@ -527,6 +528,7 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     last_odometry_ = robot->odometry;
   }
   FrameReport report;
+  image_allows_coasting_ = false;
   undistorted_ = &undistorter_.Apply(image);
   report.undistort_ms = MillisecondsSince(start);
 
@@ -609,7 +611,8 @@ void SequenceTracker::Combine(const std::optional<RobotReading>& robot,
     return;
   }
   const RobotPose now = WithReading(*robot->odometry, *robot);
-  const bool coasting = coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
+  // The anchor is dropped during the frame when the global mode takes over (a carried robot).
+  const bool coasting = anchor_ && coasted && coasted->uncertainty.status != IntegrityStatus::kLost;
   PoseUncertainty& u = report->uncertainty;
   auto report_coasted = [&]() {
     report->cam_from_world = coasted->cam_from_world;
@@ -630,11 +633,12 @@ void SequenceTracker::Combine(const std::optional<RobotReading>& robot,
     report_coasted();
     report->status = TrackStatus::kCoasting;
     report->note = coasted->note + (image.empty() ? "" : "; image: " + image);
-    // The odometry's bound holds for a robot that drove, not for one that was carried: a frame
-    // with lines on which the matcher finds nothing around the carried pose may show a carry.
-    if (failed_searches_ > 0 && u.status == IntegrityStatus::kTracking) {
+    // The odometry's bound holds for a robot that drove, not for one that was carried: the
+    // coasted pose is tracking only when the frame's image does not contradict it (too few lines
+    // to say, or the matcher finds a pose around it).
+    if (!image_allows_coasting_ && u.status == IntegrityStatus::kTracking) {
       u.status = IntegrityStatus::kDegraded;
-      const char* why = "the matcher finds nothing around the pose the odometry carries";
+      const char* why = "the image does not show the pose the odometry carries";
       u.reason = u.reason.empty() ? why : why + ("; " + u.reason);
     }
     return;

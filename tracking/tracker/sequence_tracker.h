@@ -264,6 +264,8 @@ class SequenceTracker {
   bool following_ = false;                 // the tracker holds a good pose from the previous frame
   bool ever_good_ = false;                 // a pose was accepted on some frame
   bool global_mode_ = false;               // lost frames are localised by the global mode
+  // This frame's matcher found a pose around the prior, or saw too few lines to contradict it.
+  bool image_allows_coasting_ = false;
   int failed_searches_ = 0;    // matcher searches in a row finding nothing (GlobalRecoveryOptions)
   std::string global_reason_;  // why the global mode was entered
   long frame_index_ = -1;      // frames processed - 1
