@@ -50,9 +50,13 @@ const Hall& TheHall() {
 }
 
 // The tracker as `linetrack live` builds it: the matcher set for detected lines.
-std::unique_ptr<TrackerPoseEstimator> Tracker() {
+// `image_only`: no coasting on the odometry and no global mode, so that a loss of the image is
+// recovered by the matcher and the restart alone.
+std::unique_ptr<TrackerPoseEstimator> Tracker(bool image_only) {
   TrackerEstimatorOptions options;
   options.matcher.noise = DetectedLineNoise();
+  options.sequence.coast.enabled = !image_only;
+  options.sequence.global.enabled = !image_only;
   return std::make_unique<TrackerPoseEstimator>(TheHall().model, TheHall().area, TheHall().camera,
                                                 options);
 }
@@ -65,8 +69,9 @@ struct TrackedRun {
 
 // Runs `frames` frames of the rig (rendered) with the tracker in the loop.
 TrackedRun RunWithTracker(const SimCameraOptions& camera, const LiveLoopOptions& loop,
-                          const Eigen::Vector2d& start_offset, int frames) {
-  const std::unique_ptr<TrackerPoseEstimator> tracker = Tracker();
+                          const Eigen::Vector2d& start_offset, int frames,
+                          bool image_only = false) {
+  const std::unique_ptr<TrackerPoseEstimator> tracker = Tracker(image_only);
   SimHeadStart start;
   start.offset_from_target = start_offset;
   SimulatedLiveRig rig(TheHall().model, &TheHall().area, TheHall().camera,
@@ -126,7 +131,10 @@ TEST(LiveWithTracker, ForcedLossStopsTheHeadAndTrackingRecovers) {
   camera.cap_to_s = 1.0;
   LiveLoopOptions loop;
   loop.target = kPillarCorner;
-  const TrackedRun run = RunWithTracker(camera, loop, {DegToRad(10.0), DegToRad(5.0)}, 75);
+  // The loss of the image itself: without coasting (the odometry's pose would stand in) and
+  // without the global mode (a lens capped for 25 frames would call it).
+  const TrackedRun run =
+      RunWithTracker(camera, loop, {DegToRad(10.0), DegToRad(5.0)}, 75, /*image_only=*/true);
   int stops = 0, first_pose_after = -1;
   double capped_pan = std::nan("");
   for (size_t k = 0; k < run.iterations.size(); ++k) {
