@@ -272,6 +272,7 @@ bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robo
   const double driven = driven_m_ - r.driven_at_start_m;
   if (r.frames >= check.confirm_frames && driven >= r.needed_m) {
     reacquisition_.reset();
+    global_reason_.clear();  // a confirmed pose: the global mode's drop is over
     return true;
   }
   std::string why = "re-localisation being confirmed: " + std::to_string(r.frames) + " of " +
@@ -587,14 +588,18 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
 }
 
 void SequenceTracker::WithholdUnconfirmedGlobal(FrameReport* report) const {
-  if (!reacquisition_ || !reacquisition_->global || !report->cam_from_world) return;
+  // Also a matcher's pose after the global mode dropped the last good pose: nothing before it
+  // bounds a wrong answer either (global_reason_ is kept until a pose is confirmed).
+  const bool unanchored = reacquisition_ && (reacquisition_->global ||
+                                             (!global_reason_.empty() && !reacquisition_->before));
+  if (!unanchored || !report->cam_from_world) return;
   report->cam_from_world.reset();
   PoseUncertainty& u = report->uncertainty;
   const std::string was = u.reason;
   u = PoseUncertainty();
   u.status = IntegrityStatus::kLost;
-  u.reason =
-      "a global re-localisation is reported once confirmed" + (was.empty() ? "" : ": " + was);
+  u.reason = "a re-localisation with no good pose before it is reported once confirmed" +
+             (was.empty() ? "" : ": " + was);
   report->note = u.reason;
 }
 
