@@ -125,8 +125,8 @@ void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags) {
 }
 
 CoastOptions CoastFlags::Options() const {
-  const std::vector<double> bound = ParseNumberList(
-      odometry_bound, 3, "--odometry-bound", "DISTANCE_SHARE,DEGREES_PER_METRE,TURN_SHARE");
+  const std::vector<double> bound = ParseNumberList(odometry_bound, 3, "--odometry-bound",
+                                                    "DISTANCE_SHARE,DEGREES_PER_METRE,TURN_SHARE");
   CheckRange(bound[0], 0.0, 0.99, "--odometry-bound (share of the distance driven)");
   CheckRange(bound[1], 0.0, 180.0, "--odometry-bound (degrees per metre)");
   CheckRange(bound[2], 0.0, 0.99, "--odometry-bound (share of the heading turned)");
