@@ -6,6 +6,14 @@ function(linetrack_strict_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Werror)
 endfunction()
 
+# Sources compiled on their own in a unity build (-DCMAKE_UNITY_BUILD=ON, which scripts/test.sh
+# and scripts/demo.sh use: each target's files compiled as a few large translation units): they
+# define a file-local name that another file of the same target defines too.
+function(linetrack_unity_apart)
+  set_source_files_properties(${ARGN} DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}
+                              PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+endfunction()
+
 # Precompiled headers: the third-party headers that most of the project's files include (Eigen in
 # nine files of ten, ViSP's pose and image types in four of ten, GoogleTest in every test), parsed
 # once per build instead of once per file. One header is compiled for the libraries (the first

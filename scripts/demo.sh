@@ -4,7 +4,7 @@
 # printing the result table. Idempotent. Output in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh build
+scripts/setup.sh build -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=16
 mkdir -p out/demo
 build/app/linetrack model-info models/hall.cao
 build/app/linetrack synth --model models/hall.cao --qi 3 --count 100 --out out/demo/qi3
