@@ -6,6 +6,7 @@
 
 #include "calibration/board_pose.h"
 #include "calibration/hand_eye.h"
+#include "calibration/view_shift.h"
 #include "models/pan_tilt.h"
 #include "models/statistics.h"
 
@@ -109,10 +110,24 @@ bool EstimateOnViews(const std::vector<size_t>& used, const std::vector<ViewData
   }
   result->tilt_from_camera = poses[0];
   result->base_from_board = poses[1];
-  result->covariance = solved.covariance.topLeftCorner<6, 6>();
   result->rms_px = std::sqrt(solved.cost / (0.5 * solved.residuals));
   Eigen::VectorXd r;
-  residuals(poses, &r, nullptr);
+  Eigen::MatrixXd jacobian;
+  residuals(poses, &r, &jacobian);
+  std::vector<int> points;
+  for (const BoardView& v : views)
+    points.push_back(static_cast<int>(v.image_points.size()));
+  const ViewShiftCovariance shared =
+      EstimateViewShiftCovariance(jacobian, r, points, options.view_shift_px);
+  if (!shared.ok) {
+    result->status = MountStatus::kEstimationFailed;
+    result->message = "mount refinement: a direction of the poses is not observed";
+    return false;
+  }
+  result->covariance = shared.covariance.topLeftCorner<6, 6>();
+  result->noise_sigma_px = shared.sigma_px;
+  result->view_shift_px = shared.tau_px;
+  result->view_shift_data_px = shared.tau_data_px;
   Eigen::Index row = 0;
   for (size_t k = 0; k < used.size(); ++k) {
     MountViewReport& report = result->views[used[k]];
@@ -134,6 +149,10 @@ bool MountCalibrationOptions::Check(std::string* why) const {
   if (!CheckOutlierRule(outlier_factor, outlier_min_error_px, why)) return false;
   if (min_views < 3) {
     *why = "at least 3 views are needed to calibrate a mount";
+    return false;
+  }
+  if (!(view_shift_px < 10.0)) {
+    *why = "the view shift must be under 10 pixels (negative: estimated)";
     return false;
   }
   if (!(min_axis_spread >= 0.0 && min_axis_spread < 1.0)) {

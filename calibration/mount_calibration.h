@@ -44,6 +44,10 @@ struct MountCalibrationOptions {
   // The camera's distortion in the joint refinement: kud (a camera from `calibrate`), or the
   // inverse of kdu for images the scene renderer drew (the simulated camera).
   DistortionModel distortion = DistortionModel::kKud;
+  // The displacement shared by all points of a view (pixels per image axis, view_shift.h): < 0
+  // estimated from the residuals; >= 0 known, e.g. f q / sqrt(12) for logged head angles rounded
+  // to steps of q radians.
+  double view_shift_px = -1.0;
 
   bool Check(std::string* why) const;
 };
@@ -78,11 +82,15 @@ struct MountCalibration {
   Eigen::Isometry3d hand_eye_start = Eigen::Isometry3d::Identity();  // ViSP's
   int hand_eye_status = 0;                                           // HandEyeStart::visp_status
   // Covariance of the mount's MovedPose delta (shift in metres, rotation vector in radians, both
-  // in the tilt frame: tilt_from_camera = (t + shift, Exp(w) R)), from s^2 (J^T J)^-1 of the joint
-  // refinement (the intrinsics taken as exact).
+  // in the tilt frame: tilt_from_camera = (t + shift, Exp(w) R)): the joint refinement's under
+  // independent pixel noise plus a displacement shared by each view's points (view_shift.h; the
+  // intrinsics taken as exact).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  double rms_px = 0.0;       // over every point of the used views
-  double axis_spread = 0.0;  // RotationAxisSpread of the used views
+  double noise_sigma_px = 0.0;      // the independent noise per coordinate (pixels)
+  double view_shift_px = 0.0;       // the shared displacement per axis in `covariance` (pixels)
+  double view_shift_data_px = 0.0;  // its estimate from the residuals alone (pixels)
+  double rms_px = 0.0;              // over every point of the used views
+  double axis_spread = 0.0;         // RotationAxisSpread of the used views
   int rejection_rounds = 0;
 
   bool ok() const { return status == MountStatus::kOk; }

@@ -239,6 +239,8 @@ std::string MountJson(const MountCalibration& mount, const MountRunInfo& info) {
         {"parameterisation",
          "tilt_from_camera = (t + shift, Exp(rotation) R): a shift of the camera centre and a "
          "rotation vector, both in the tilt frame; intrinsics taken as exact"},
+        {"noise_px", mount.noise_sigma_px},
+        {"view_shift_px", mount.view_shift_px},
         {"matrix", MatrixJson(mount.covariance)}}},
       {"sigma",
        {{"position_mm", {1e3 * sigma[0], 1e3 * sigma[1], 1e3 * sigma[2]}},

@@ -106,6 +106,8 @@ nlohmann::ordered_json ToJson(const MountBenchRun& r) {
           {"position_sigma_mm", 1e3 * sigma.head<3>().norm()},
           {"rotation_sigma_deg", RadToDeg(sigma.tail<3>().norm())},
           {"nees", r.nees},
+          {"noise_px", r.mount.noise_sigma_px},
+          {"view_shift_px", r.mount.view_shift_px},
           {"hand_eye_position_error_mm", 1e3 * r.start_error.head<3>().norm()},
           {"hand_eye_rotation_error_deg", RadToDeg(r.start_error.tail<3>().norm())},
           {"seconds", r.seconds}};
