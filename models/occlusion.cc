@@ -174,18 +174,13 @@ bool OcclusionTester::AlongPlan(const Layer& layer, const Eigen::Vector3d& a,
   return false;
 }
 
-bool OcclusionTester::Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-                              double tolerance) const {
-  return SightLine(eye, target, tolerance).Crosses(faces_[i]);
-}
-
 bool OcclusionTester::Blocked(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                               double tolerance) const {
   // A model of a few faces (one room) is quicker to test face by face than to walk.
   if (faces_.size() <= kFacesWithoutGrid) return BlockedByAnyFace(eye, target, tolerance);
   if ((target - eye).norm() <= tolerance) return false;
-  // Only a face whose z extent meets the segment's, grown by the tolerance, can cross it (Crosses'
-  // box test): such a face is listed in a layer that the grown extent meets.
+  // Only a face whose z extent meets the segment's, grown by the tolerance, can cross it
+  // (SightLine::Crosses' box test): such a face is listed in a layer that the grown extent meets.
   const SightLine sight(eye, target, tolerance);
   const double z_lo = sight.lo.z() - tolerance, z_hi = sight.hi.z() + tolerance;
   const auto crosses = [&](int i) { return sight.Crosses(faces_[i]); };

@@ -32,9 +32,6 @@ class OcclusionTester {
     std::vector<Eigen::Vector2d> polygon;  // face corners in (axis_u, axis_v)
     Eigen::Vector3d box_min, box_max;      // bounding box, for a quick reject
   };
-  // True when face i crosses the open segment eye -> target before target (see Blocked).
-  bool Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-               double tolerance) const;
   // A slice of world z, from one storey's slab to the next: the plan grid's cells list only the
   // faces whose z extent meets [z_lo, z_hi].
   struct Layer {
