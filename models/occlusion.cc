@@ -21,6 +21,36 @@ bool InsidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vec
   return inside;
 }
 
+// The segment of sight from `eye` to `target` with what every face's test needs: its direction,
+// length and box, and the tolerance (metres) within which a face through `target` does not count.
+struct SightLine {
+  SightLine(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, double tolerance)
+      : eye(eye),
+        dir(target - eye),
+        lo(eye.cwiseMin(target)),
+        hi(eye.cwiseMax(target)),
+        length(dir.norm()),
+        tolerance(tolerance) {}
+
+  // True when `face` crosses the open segment before the target (OcclusionTester::Blocked).
+  template <typename Face>
+  bool Crosses(const Face& face) const {
+    if ((face.box_max.array() < lo.array() - tolerance).any() ||
+        (face.box_min.array() > hi.array() + tolerance).any()) {
+      return false;
+    }
+    const double denom = face.normal.dot(dir);
+    if (std::abs(denom) < 1e-12) return false;  // parallel to the face
+    const double t = (face.offset - face.normal.dot(eye)) / denom;
+    if (t <= 0.0 || t * length >= length - tolerance) return false;
+    const Eigen::Vector3d hit = eye + t * dir;
+    return InsidePolygon(face.polygon, Eigen::Vector2d(hit[face.axis_u], hit[face.axis_v]));
+  }
+
+  Eigen::Vector3d eye, dir, lo, hi;
+  double length = 0.0, tolerance = 0.0;
+};
+
 // Faces are listed in the grid cells their plan box, grown by this (metres), meets: far above the
 // rounding of a hit point; cells are no smaller than kMinCell (metres).
 constexpr double kPlanMargin = 1e-6;
@@ -47,12 +77,25 @@ OcclusionTester::OcclusionTester(const WireframeModel& model) {
     }
     faces_.push_back(std::move(face));
   }
-  BuildPlanGrid();
+  BuildPlanGrid(model);
 }
 
-void OcclusionTester::BuildPlanGrid() {
+void OcclusionTester::BuildPlanGrid(const WireframeModel& model) {
+  // Layers split in the middle of each slab between two storeys (floor of the upper one, top of
+  // the lower one): a sight line within a storey meets the faces of its own layer only.
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> cuts = {-inf};
+  const std::vector<Storey>& storeys = model.storeys();
+  for (size_t s = 1; s < storeys.size(); ++s) {
+    const double cut = 0.5 * (storeys[s - 1].top_z + storeys[s].floor_z);
+    if (cut > cuts.back()) cuts.push_back(cut);
+  }
+  cuts.push_back(inf);
+  for (size_t k = 0; k + 1 < cuts.size(); ++k)
+    layers_.push_back({cuts[k], cuts[k + 1], {}});
   if (faces_.empty()) {
-    cells_.assign(1, {});
+    for (Layer& layer : layers_)
+      layer.cells.assign(1, {});
     return;
   }
   Eigen::Vector2d lo = faces_.front().box_min.head<2>(), hi = faces_.front().box_max.head<2>();
@@ -65,14 +108,19 @@ void OcclusionTester::BuildPlanGrid() {
   origin_ = lo;
   cols_ = static_cast<int>(extent.x() / cell_) + 1;
   rows_ = static_cast<int>(extent.y() / cell_) + 1;
-  cells_.assign(static_cast<size_t>(cols_) * rows_, {});
+  for (Layer& layer : layers_)
+    layer.cells.assign(static_cast<size_t>(cols_) * rows_, {});
   for (size_t i = 0; i < faces_.size(); ++i) {
-    const Eigen::Vector2d a = faces_[i].box_min.head<2>() - Eigen::Vector2d::Constant(kPlanMargin);
-    const Eigen::Vector2d b = faces_[i].box_max.head<2>() + Eigen::Vector2d::Constant(kPlanMargin);
+    const Face& face = faces_[i];
+    const Eigen::Vector2d a = face.box_min.head<2>() - Eigen::Vector2d::Constant(kPlanMargin);
+    const Eigen::Vector2d b = face.box_max.head<2>() + Eigen::Vector2d::Constant(kPlanMargin);
     const Eigen::Vector4i r(Col(a.x()), Col(b.x()), Row(a.y()), Row(b.y()));
-    for (int row = r[2]; row <= r[3]; ++row) {
-      for (int col = r[0]; col <= r[1]; ++col)
-        cells_[static_cast<size_t>(row) * cols_ + col].push_back(static_cast<int>(i));
+    for (Layer& layer : layers_) {
+      if (face.box_max.z() < layer.z_lo || face.box_min.z() > layer.z_hi) continue;
+      for (int row = r[2]; row <= r[3]; ++row) {
+        for (int col = r[0]; col <= r[1]; ++col)
+          layer.cells[static_cast<size_t>(row) * cols_ + col].push_back(static_cast<int>(i));
+      }
     }
     rectangles_.push_back(r);
   }
@@ -87,8 +135,8 @@ int OcclusionTester::Row(double y) const {
 }
 
 template <typename Test>
-bool OcclusionTester::AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                const Test& test) const {
+bool OcclusionTester::AlongPlan(const Layer& layer, const Eigen::Vector3d& a,
+                                const Eigen::Vector3d& b, const Test& test) const {
   // Cells of the plan segment a -> b (Amanatides-Woo); the segment is not clipped to the grid:
   // outside it, cells are clamped to its border, which lists every face there may be.
   const Eigen::Vector2d p = a.head<2>(), d = b.head<2>() - p;
@@ -106,7 +154,7 @@ bool OcclusionTester::AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d&
                    : inf;
   int prev_c = -1, prev_r = -1;
   for (int guard = 0; guard < cols_ + rows_ + 2; ++guard) {
-    for (int i : cells_[static_cast<size_t>(r) * cols_ + c]) {
+    for (int i : layer.cells[static_cast<size_t>(r) * cols_ + c]) {
       // A face met in the previous cell was tested there (the walk is contiguous in its box).
       const Eigen::Vector4i& box = rectangles_[i];
       if (prev_c >= box[0] && prev_c <= box[1] && prev_r >= box[2] && prev_r <= box[3]) continue;
@@ -126,39 +174,29 @@ bool OcclusionTester::AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d&
   return false;
 }
 
-bool OcclusionTester::Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-                              double tolerance) const {
-  const Face& face = faces_[i];
-  const Eigen::Vector3d dir = target - eye;
-  const Eigen::Vector3d lo = eye.cwiseMin(target), hi = eye.cwiseMax(target);
-  if ((face.box_max.array() < lo.array() - tolerance).any() ||
-      (face.box_min.array() > hi.array() + tolerance).any()) {
-    return false;
-  }
-  const double denom = face.normal.dot(dir);
-  if (std::abs(denom) < 1e-12) return false;  // parallel to the face
-  const double length = dir.norm();
-  const double t = (face.offset - face.normal.dot(eye)) / denom;
-  if (t <= 0.0 || t * length >= length - tolerance) return false;
-  const Eigen::Vector3d hit = eye + t * dir;
-  return InsidePolygon(face.polygon, Eigen::Vector2d(hit[face.axis_u], hit[face.axis_v]));
-}
-
 bool OcclusionTester::Blocked(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                               double tolerance) const {
   // A model of a few faces (one room) is quicker to test face by face than to walk.
   if (faces_.size() <= kFacesWithoutGrid) return BlockedByAnyFace(eye, target, tolerance);
   if ((target - eye).norm() <= tolerance) return false;
-  return AlongPlan(eye, target, [&](int i) { return Crosses(i, eye, target, tolerance); });
+  // Only a face whose z extent meets the segment's, grown by the tolerance, can cross it
+  // (SightLine::Crosses' box test): such a face is listed in a layer that the grown extent meets.
+  const SightLine sight(eye, target, tolerance);
+  const double z_lo = sight.lo.z() - tolerance, z_hi = sight.hi.z() + tolerance;
+  const auto crosses = [&](int i) { return sight.Crosses(faces_[i]); };
+  for (const Layer& layer : layers_) {
+    if (layer.z_hi < z_lo || layer.z_lo > z_hi) continue;
+    if (AlongPlan(layer, eye, target, crosses)) return true;
+  }
+  return false;
 }
 
 bool OcclusionTester::BlockedByAnyFace(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                                        double tolerance) const {
   if ((target - eye).norm() <= tolerance) return false;
-  for (size_t i = 0; i < faces_.size(); ++i) {
-    if (Crosses(static_cast<int>(i), eye, target, tolerance)) return true;
-  }
-  return false;
+  const SightLine sight(eye, target, tolerance);
+  return std::any_of(faces_.begin(), faces_.end(),
+                     [&](const Face& face) { return sight.Crosses(face); });
 }
 
 bool ClipToFrustum(const Eigen::Isometry3d& cam_from_world, const CameraIntrinsics& camera,

@@ -32,25 +32,31 @@ class OcclusionTester {
     std::vector<Eigen::Vector2d> polygon;  // face corners in (axis_u, axis_v)
     Eigen::Vector3d box_min, box_max;      // bounding box, for a quick reject
   };
-  // True when face i crosses the open segment eye -> target before target (see Blocked).
-  bool Crosses(int i, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-               double tolerance) const;
-  // Fills the plan grid below from the faces' boxes.
-  void BuildPlanGrid();
+  // A slice of world z, from one storey's slab to the next: the plan grid's cells list only the
+  // faces whose z extent meets [z_lo, z_hi].
+  struct Layer {
+    double z_lo = 0.0, z_hi = 0.0;
+    std::vector<std::vector<int>> cells;
+  };
+  // Fills the plan grid below from the faces' boxes, one layer per storey of `model`.
+  void BuildPlanGrid(const WireframeModel& model);
   int Col(double x) const;
   int Row(double y) const;
-  // Calls test(face index) for the faces whose plan box meets a cell that the plan projection of
-  // a -> b passes through, each once, cell by cell from a; stops when test returns true.
+  // Calls test(face index) for the faces of `layer` whose plan box meets a cell that the plan
+  // projection of a -> b passes through, each once, cell by cell from a; stops when test returns
+  // true.
   template <typename Test>
-  bool AlongPlan(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Test& test) const;
+  bool AlongPlan(const Layer& layer, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                 const Test& test) const;
 
   std::vector<Face> faces_;
-  // A uniform grid over the faces' plan boxes: the faces meeting each cell, and per face the
-  // rectangle of cells [col_lo, col_hi] x [row_lo, row_hi] it is listed in.
+  // A uniform grid over the faces' plan boxes, per layer: the faces meeting each cell, and per face
+  // the rectangle of cells [col_lo, col_hi] x [row_lo, row_hi] it is listed in. The layers cover
+  // every z; a face is listed in each layer its z extent meets.
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   double cell_ = 1.0;
   int cols_ = 1, rows_ = 1;
-  std::vector<std::vector<int>> cells_;
+  std::vector<Layer> layers_;
   std::vector<Eigen::Vector4i> rectangles_;
 };
 

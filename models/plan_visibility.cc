@@ -21,25 +21,21 @@ double Support(const Ring2& points, const Eigen::Vector2d& n) {
   return best;
 }
 
-// Outward normals of a counter-clockwise ring's edges (both normals for a two-point footprint).
-void AddEdgeNormals(const Ring2& ring, std::vector<Eigen::Vector2d>* normals) {
+// True when test(n) holds for an outward unit normal n of a counter-clockwise ring's edges (both
+// normals for a two-point footprint); the normals are tried in order, the first true stops.
+template <typename Test>
+bool AnyEdgeNormal(const Ring2& ring, const Test& test) {
   if (ring.size() == 2) {
     const Eigen::Vector2d d = ring[1] - ring[0];
-    if (d.norm() > 0.0) {
-      normals->push_back(Eigen::Vector2d(d.y(), -d.x()).normalized());
-      normals->push_back(-normals->back());
-    }
-    return;
+    if (!(d.norm() > 0.0)) return false;
+    const Eigen::Vector2d n = Eigen::Vector2d(d.y(), -d.x()).normalized();
+    return test(n) || test(-n);
   }
   for (size_t i = 0; i < ring.size(); ++i) {
     const Eigen::Vector2d d = ring[(i + 1) % ring.size()] - ring[i];
-    if (d.norm() > 0.0) normals->push_back(Eigen::Vector2d(d.y(), -d.x()).normalized());
+    if (d.norm() > 0.0 && test(Eigen::Vector2d(d.y(), -d.x()).normalized())) return true;
   }
-}
-
-void AddDirection(const Eigen::Vector2d& v, std::vector<Eigen::Vector2d>* normals) {
-  const double norm = v.norm();
-  if (norm > 1e-15) normals->push_back(v / norm);
+  return false;
 }
 
 // False when the boxes of the region ([r_lo, r_hi]) and the footprint are too far apart for the
@@ -216,12 +212,17 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
 }
 
 bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin) {
+  return HiddenBySolid(region, RingCentroid(region), footprint, solid, margin);
+}
+
+bool HiddenBySolid(const Ring2& region, const Eigen::Vector2d& region_centroid,
+                   const Ring2& footprint, const Ring2& solid, double margin) {
   if (!ConvexInteriorsDisjoint(region, solid, kTouch)) return false;
   // Cheap necessary condition first: the sight line between the centres crosses the solid.
   Eigen::Vector2d f_mid = Eigen::Vector2d::Zero();
   for (const Eigen::Vector2d& f : footprint)
     f_mid += f / static_cast<double>(footprint.size());
-  const Segment2 centre_line{RingCentroid(region), f_mid};
+  const Segment2 centre_line{region_centroid, f_mid};
   double t0 = 0.0, t1 = 0.0;
   if (!ClipSegmentToConvex(solid, centre_line, &t0, &t1) ||
       (t1 - t0) * centre_line.Length() < margin) {
@@ -229,27 +230,33 @@ bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& sol
   }
   // g(n) = min(h_R(n), h_F(n)) - h_P(n) is piecewise a min of two sinusoids between the edge
   // normals; its maximum lies at an edge normal, at a stationary point (n along r - v or f - v)
-  // or where the two sinusoids cross (n orthogonal to r - f).
-  std::vector<Eigen::Vector2d> normals;
-  AddEdgeNormals(region, &normals);
-  AddEdgeNormals(footprint, &normals);
-  AddEdgeNormals(solid, &normals);
+  // or where the two sinusoids cross (n orthogonal to r - f). Each candidate n is tested as it
+  // comes: the first with g(n) > -margin decides.
+  const auto separates = [&](const Eigen::Vector2d& n) {
+    return std::min(Support(region, n), Support(footprint, n)) > Support(solid, n) - margin;
+  };
+  const auto direction_separates = [&](const Eigen::Vector2d& v) {
+    const double norm = v.norm();
+    return norm > 1e-15 && separates(v / norm);
+  };
+  if (AnyEdgeNormal(region, separates) || AnyEdgeNormal(footprint, separates) ||
+      AnyEdgeNormal(solid, separates)) {
+    return false;
+  }
   for (const Eigen::Vector2d& v : solid) {
-    for (const Eigen::Vector2d& r : region)
-      AddDirection(r - v, &normals);
-    for (const Eigen::Vector2d& f : footprint)
-      AddDirection(f - v, &normals);
+    for (const Eigen::Vector2d& r : region) {
+      if (direction_separates(r - v)) return false;
+    }
+    for (const Eigen::Vector2d& f : footprint) {
+      if (direction_separates(f - v)) return false;
+    }
   }
   for (const Eigen::Vector2d& r : region) {
     for (const Eigen::Vector2d& f : footprint) {
       const Eigen::Vector2d d = r - f;
-      AddDirection({d.y(), -d.x()}, &normals);
-      AddDirection({-d.y(), d.x()}, &normals);
+      if (direction_separates({d.y(), -d.x()}) || direction_separates({-d.y(), d.x()}))
+        return false;
     }
-  }
-  for (const Eigen::Vector2d& n : normals) {
-    const double h_solid = Support(solid, n);
-    if (std::min(Support(region, n), Support(footprint, n)) > h_solid - margin) return false;
   }
   return true;
 }

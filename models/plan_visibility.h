@@ -54,6 +54,9 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
 // max over the region or over the footprint of n.x stays `margin` metres below max over the
 // solid (no line separates the solid from a point of each). False when the region overlaps it.
 bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin);
+// The same, given the region's RingCentroid.
+bool HiddenBySolid(const Ring2& region, const Eigen::Vector2d& region_centroid,
+                   const Ring2& footprint, const Ring2& solid, double margin);
 
 // The part of the floor-plan `footprint` that a camera anywhere in the disk (centre, radius) can
 // see under a bearing within [heading - half, heading + half] (radians): the footprint clipped to

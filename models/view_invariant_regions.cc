@@ -128,6 +128,19 @@ StoreyEdges EdgesOfStorey(const WireframeModel& model, const std::vector<Storey>
         (closed_below || e_lo >= z_lo - kTol) && (closed_above || e_hi <= z_hi + kTol);
     edges.in_band.push_back(in_band ? 1 : 0);
   }
+  std::map<std::pair<char, std::vector<double>>, int> first;
+  for (size_t k = 0; k < edges.ids.size(); ++k) {
+    Ring2 points = edges.footprints[k];
+    std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+      return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+    });
+    std::vector<double> key;
+    for (const Eigen::Vector2d& p : points)
+      key.insert(key.end(), {p.x(), p.y()});
+    edges.same_as.push_back(
+        first.emplace(std::make_pair(edges.in_band[k], std::move(key)), static_cast<int>(k))
+            .first->second);
+  }
   return edges;
 }
 

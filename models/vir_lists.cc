@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -53,9 +55,9 @@ struct RecentWalls {
   int next = 0;
 };
 
-// True when an occluder or a solid hides the whole footprint from the whole region: only those
-// crossing the line between their centres can (docs/models.md). The walls of `recent` that cross
-// it are tried first, and a wall that hides the footprint joins them.
+// True when an occluder or a solid hides the whole footprint from the whole region (`from` its
+// RingCentroid): only those crossing the line between their centres can (docs/models.md). The walls
+// of `recent` that cross it are tried first, and a wall that hides the footprint joins them.
 bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footprint,
             const StoreyOccluders& o, double margin, RecentWalls* recent) {
   const Eigen::Vector2d to = Centre(footprint);
@@ -87,7 +89,7 @@ bool Hidden(const Ring2& region, const Eigen::Vector2d& from, const Ring2& footp
     const int solid = o.solid_of_side[side];
     if (o.seen[solid] == o.test) return false;
     o.seen[solid] = o.test;
-    return HiddenBySolid(region, footprint, o.solids[solid], margin);
+    return HiddenBySolid(region, from, footprint, o.solids[solid], margin);
   });
   return by_solid;
 }
@@ -174,13 +176,27 @@ void ClipToHalfPlane(const SmallRing& ring, const Eigen::Vector2d& n, double off
   }
 }
 
+// std::nextafter(x, -infinity), by the bits of the float: the next float below x (-0 and +0 step
+// to minus the smallest subnormal, +infinity to the largest float; NaN and -infinity stay).
+float StepDown(float x) {
+  if (!(x > -std::numeric_limits<float>::infinity())) return x;
+  if (x == 0.0f) return -std::numeric_limits<float>::denorm_min();
+  uint32_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = x > 0.0f ? bits - 1 : bits + 1;
+  std::memcpy(&x, &bits, sizeof bits);
+  return x;
+}
+
+// std::nextafter(x, +infinity).
+float StepUp(float x) {
+  return -StepDown(-x);
+}
+
 // The box of a float box holding [lo, hi].
 CellOccluder Occluder(int id, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
-  const float inf = std::numeric_limits<float>::infinity();
-  return {id, std::nextafter(static_cast<float>(lo.x()), -inf),
-          std::nextafter(static_cast<float>(lo.y()), -inf),
-          std::nextafter(static_cast<float>(hi.x()), inf),
-          std::nextafter(static_cast<float>(hi.y()), inf)};
+  return {id, StepDown(static_cast<float>(lo.x())), StepDown(static_cast<float>(lo.y())),
+          StepUp(static_cast<float>(hi.x())), StepUp(static_cast<float>(hi.y()))};
 }
 
 // A counter-clockwise convex ring and its edges' outward unit normals (none for a zero edge).
@@ -306,22 +322,40 @@ bool ShadowBox(const Ring2& ring, const Ring2& footprint, const Segment2& wall, 
 CellList CellVisibility(const Ring2& ring, const WireframeModel& model, const StoreyEdges& edges,
                         const StoreyOccluders& occluders, double margin, CellOccluders keep) {
   CellList list;
-  if (keep == CellOccluders::kKeep) list.first.push_back(0);
+  const bool kept = keep == CellOccluders::kKeep;
+  if (kept) list.first.push_back(0);
   const Eigen::Vector2d centre = RingCentroid(ring);
   Ring2 points;
   HullAxes axes;
   RecentWalls recent;
+  // Per footprint (its first entry, StoreyEdges::same_as): not decided yet, hidden, or in sight,
+  // with the list index of the first edge listed with it (whose occluders it shares).
+  constexpr int kUndecided = -1, kHidden = -2;
+  std::vector<int> decided(edges.ids.size(), kUndecided);
   for (size_t k = 0; k < edges.ids.size(); ++k) {
     const ModelEdge& edge = model.edges()[edges.ids[k]];
     if (BehindItsFaces(edge, ring, model, edges, margin)) continue;
     const Ring2& footprint = edges.footprints[k];
     if (edges.in_band[k]) {
-      if (Hidden(ring, centre, footprint, occluders, margin, &recent)) continue;
-      if (keep == CellOccluders::kKeep)
-        OccludersOfFootprint(ring, footprint, occluders, margin, &points, &axes, &list.occluders);
+      int& state = decided[edges.same_as[k]];
+      if (state == kHidden) continue;
+      if (state == kUndecided) {
+        if (Hidden(ring, centre, footprint, occluders, margin, &recent)) {
+          state = kHidden;
+          continue;
+        }
+        state = static_cast<int>(list.edges.size());
+        if (kept)
+          OccludersOfFootprint(ring, footprint, occluders, margin, &points, &axes, &list.occluders);
+      } else if (kept) {
+        for (int i = list.first[state]; i < list.first[state + 1]; ++i) {
+          const CellOccluder copy = list.occluders[i];
+          list.occluders.push_back(copy);
+        }
+      }
     }
     list.edges.push_back(static_cast<int>(k));
-    if (keep == CellOccluders::kKeep) {
+    if (kept) {
       list.first.push_back(static_cast<int>(list.occluders.size()));
       list.maybe_behind.push_back(MaybeBehindItsFaces(edge, ring, model, edges, margin) ? 1 : 0);
     }
@@ -347,11 +381,23 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
   const Eigen::Vector2d centroid = RingCentroid(ring);
   const bool walk = cell.first.empty();
   RecentWalls recent;
+  // Per footprint (StoreyEdges::same_as): not decided yet, hidden, or the index in `visible` of
+  // the first edge listed with it, whose bearings it shares.
+  constexpr int kUndecided = -1, kHidden = -2;
+  std::vector<int> decided(edges.ids.size(), kUndecided);
   for (size_t j = 0; j < cell.edges.size(); ++j) {
     const int k = cell.edges[j];
     const ModelEdge& edge = model.edges()[edges.ids[k]];
     if ((walk || cell.maybe_behind[j]) && BehindItsFaces(edge, ring, model, edges, margin))
       continue;
+    int& state = decided[edges.same_as[k]];
+    if (state == kHidden) continue;
+    if (state >= 0) {
+      RegionEdge listed = visible[state];
+      listed.edge_id = edge.id;
+      visible.push_back(listed);
+      continue;
+    }
     const Ring2& footprint = edges.footprints[k];
     // An occluder hides the edge from the region only when it hides it from all its points: the
     // region lies in the occluder's box.
@@ -360,17 +406,19 @@ std::vector<RegionEdge> RegionVisibility(const Cell& region, const WireframeMode
           region.hi.y() > o.hi_y) {
         return false;
       }
-      return o.id >= 0 ? HiddenByWall(ring, footprint, occluders.walls.segments()[o.id],
-                                      occluders.wall_lines[o.id], margin)
-                       : HiddenBySolid(ring, footprint, occluders.solids[-1 - o.id], margin);
+      return o.id >= 0
+                 ? HiddenByWall(ring, footprint, occluders.walls.segments()[o.id],
+                                occluders.wall_lines[o.id], margin)
+                 : HiddenBySolid(ring, centroid, footprint, occluders.solids[-1 - o.id], margin);
     };
-    if (edges.in_band[k]) {
-      if (walk && Hidden(ring, centroid, footprint, occluders, margin, &recent)) continue;
-      if (!walk && std::any_of(cell.occluders.data() + cell.first[j],
-                               cell.occluders.data() + cell.first[j + 1], hides)) {
-        continue;
-      }
+    if (edges.in_band[k] &&
+        (walk ? Hidden(ring, centroid, footprint, occluders, margin, &recent)
+              : std::any_of(cell.occluders.data() + cell.first[j],
+                            cell.occluders.data() + cell.first[j + 1], hides))) {
+      state = kHidden;
+      continue;
     }
+    state = static_cast<int>(visible.size());
     const BearingRange range = BearingsToFootprint(ring, region.lo, region.hi, footprint);
     RegionEdge& listed = visible.emplace_back();
     listed.edge_id = edge.id;

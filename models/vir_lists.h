@@ -22,6 +22,10 @@ struct StoreyEdges {
   std::vector<int> ids;
   std::vector<Ring2> footprints;  // per entry of ids
   std::vector<char> in_band;      // per entry of ids
+  // Per entry of ids: the first entry with the same footprint points (in any order) and band,
+  // itself when none. The top and bottom edges of a wall share a footprint: whether the occluders
+  // hide it, and which can, is decided once per cell and region.
+  std::vector<int> same_as;
   double z_lo = 0.0, z_hi = 0.0;  // the cameras' band (metres)
   const std::vector<std::vector<int>>* one_sided_faces =
       nullptr;  // per edge id: its faces, all one-sided

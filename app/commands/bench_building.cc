@@ -34,6 +34,8 @@ struct BenchBuildingOptions {
   uint64_t seed = 1;
   int max_rooms = 0;  // 0: every room
   std::string out_path;
+  std::string regions_path;  // every region of the building, to compare two builds
+  int regions_threads = 0;   // ViewInvariantRegionsOptions::threads of the building's regions
 };
 
 double MsSince(Clock::time_point start) {
@@ -63,14 +65,16 @@ struct Setup {
   double regions_cpu_ms = 0.0;  // CPU time of the build, all threads
 };
 
-Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera) {
+Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera, int regions_threads) {
   Setup s;
   s.model = std::make_unique<WireframeModel>(WireframeModel::FromCao(cao));
   s.area = std::make_unique<NavigableArea>(NavigableArea::FromModel(*s.model));
   const Clock::time_point start = Clock::now();
   const double cpu_start = ProcessCpuSeconds();
-  s.regions =
-      std::make_unique<ViewInvariantRegions>(ViewInvariantRegions::Build(*s.model, *s.area));
+  ViewInvariantRegionsOptions options;
+  options.threads = regions_threads;
+  s.regions = std::make_unique<ViewInvariantRegions>(
+      ViewInvariantRegions::Build(*s.model, *s.area, options));
   s.regions_cpu_ms = 1e3 * (ProcessCpuSeconds() - cpu_start);
   s.regions_ms = MsSince(start);
   s.localizer = std::make_unique<Localizer>(*s.model, s.regions.get(), s.area.get(), camera);
@@ -111,12 +115,31 @@ NavigableArea RoomArea(const NavigableArea& alone, int storey, const std::vector
                                   alone.source());
 }
 
+// Every region of `regions`: its storey, polygon and list (edge id, all bearings, diamond arc),
+// numbers to 17 digits, one region a line.
+std::string RegionsText(const ViewInvariantRegions& regions) {
+  std::ostringstream out;
+  out.precision(17);
+  for (const ViewRegion& region : regions.regions()) {
+    out << "storey " << region.storey << " polygon";
+    for (const Eigen::Vector2d& p : region.polygon.vertices)
+      out << ' ' << p.x() << ' ' << p.y();
+    out << " visible";
+    for (const RegionEdge& e : region.visible)
+      out << ' ' << e.edge_id << ' ' << e.all_bearings << ' ' << e.diamond_min << ' '
+          << e.diamond_max;
+    out << '\n';
+  }
+  return out.str();
+}
+
 int RunBenchBuilding(const BenchBuildingOptions& opt) {
   const CameraIntrinsics camera = PaperSyntheticCamera();
   const SyntheticBuilding building = GenerateBuilding(opt.spec);
   const double rss_before = MaxRssMb();
-  const Setup whole = Prepare(building.cao, camera);
+  const Setup whole = Prepare(building.cao, camera, opt.regions_threads);
   const double rss_after = MaxRssMb();
+  if (!opt.regions_path.empty()) WriteFileAtomically(opt.regions_path, RegionsText(*whole.regions));
   std::ostringstream out;
   char line[256];
   int rooms = 0;
@@ -140,7 +163,8 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
     const BuildingSpace& room = building.spaces[k];
     if (room.corridor || (opt.max_rooms > 0 && done >= opt.max_rooms)) continue;
     ++done;
-    const Setup alone = Prepare(SpaceAlone(opt.spec, static_cast<int>(k)), camera);
+    const Setup alone =
+        Prepare(SpaceAlone(opt.spec, static_cast<int>(k)), camera, opt.regions_threads);
     const NavigableArea sampling = RoomArea(*alone.area, room.storey, whole.model->storeys());
     out << "| " << room.name;
     for (int qi = 1; qi <= 3; ++qi) {
@@ -196,8 +220,16 @@ void AddBenchBuilding(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--rooms", opt->max_rooms, "Only the first N rooms (0: all)")
       ->capture_default_str();
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
+  cmd->add_option("--regions-threads", opt->regions_threads,
+                  "Threads building the regions' lists (0: one per hardware thread)")
+      ->capture_default_str();
+  cmd->add_option("--regions-out", opt->regions_path,
+                  "Write every region of the building (storey, polygon, list) to this file, to "
+                  "compare two builds");
   cmd->callback([opt, action] {
     if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
+    if (opt->regions_threads < 0 || opt->regions_threads > 256)
+      throw CLI::ValidationError("--regions-threads", "must be in [0, 256]");
     *action = [opt] { return RunBenchBuilding(*opt); };
   });
 }

@@ -14,8 +14,8 @@ namespace linetrack {
 namespace {
 
 // Segments over the model's box grown by 1 m in plan: every fourth short, every fourth ending on a
-// model edge, every sixteenth vertical. Returns how many are blocked; expects Blocked to agree
-// with BlockedByAnyFace on each.
+// model edge, every eighth inside one storey, every sixteenth vertical. Returns how many are
+// blocked; expects Blocked to agree with BlockedByAnyFace on each.
 int ExpectGridEqualsEveryFace(const WireframeModel& model, int count) {
   const OcclusionTester occlusion(model);
   std::mt19937 rng(7u);
@@ -28,12 +28,17 @@ int ExpectGridEqualsEveryFace(const WireframeModel& model, int count) {
   };
   int blocked = 0;
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d a = pick();
+    Eigen::Vector3d a = pick();
     Eigen::Vector3d b = pick();
     if (i % 4 == 1) b = a + (b - a).normalized() * 4.0 * u(rng);
     if (i % 4 == 2) {
       const Segment3& edge = model.edges()[rng() % model.edges().size()].segment;
       b = edge.a + u(rng) * (edge.b - edge.a);
+    }
+    if (i % 8 == 5) {  // both ends within one storey: the walk of a single layer
+      const Storey& storey = model.storeys()[(i / 8) % model.storeys().size()];
+      a.z() = storey.floor_z + u(rng) * (storey.top_z - storey.floor_z);
+      b.z() = storey.floor_z + u(rng) * (storey.top_z - storey.floor_z);
     }
     if (i % 16 == 3) b.head<2>() = a.head<2>();
     const bool any_face = occlusion.BlockedByAnyFace(a, b);
