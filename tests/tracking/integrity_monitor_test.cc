@@ -15,9 +15,12 @@ namespace linetrack {
 namespace {
 
 using integrity_test::Observe;
+using integrity_test::RealisticNoise;
+using integrity_test::RobotParameters;
 using integrity_test::RoomEdges;
 using integrity_test::SceneNoise;
 using integrity_test::SolverOptionsFor;
+using integrity_test::Start;
 using integrity_test::TestCamera;
 using integrity_test::TestRobotPose;
 
@@ -26,28 +29,10 @@ constexpr int kSeeds = 8;
 constexpr double kMinDetectedShare = 0.8;
 const std::vector<int> kFloorLines = {0, 9};  // RoomEdges(): the floor lines along the room
 
-SceneNoise RealisticNoise() {
-  SceneNoise noise;
-  noise.point_px = 0.15;
-  noise.model_m = 0.005;
-  noise.latch_px = 0.3;
-  return noise;
-}
-
 IntegrityOptions OptionsFor(const SceneNoise& noise) {
   IntegrityOptions options;
   options.solver = SolverOptionsFor(noise);
   return options;
-}
-
-PoseParameterisation RobotParameters() {
-  return PoseParameterisation(KnownHeightTilt{TestRobotPose().height, TestRobotPose().tilt});
-}
-
-Eigen::Isometry3d Start(const Eigen::Isometry3d& truth) {
-  WorldTwist offset;
-  offset << 0.02, -0.01, 0.0, 0.0, 0.0, DegToRad(0.3);
-  return ApplyWorldTwist(truth, offset);
 }
 
 // Position (metres) and heading (radians) errors of a robot estimate.

@@ -82,6 +82,28 @@ inline EdgePoseSolverOptions SolverOptionsFor(const SceneNoise& noise) {
   return options;
 }
 
+// The edge noise of the monitor tests: 0.15 px per point, 5 mm of model error per end, a 0.3 px
+// latch per edge.
+inline SceneNoise RealisticNoise() {
+  SceneNoise noise;
+  noise.point_px = 0.15;
+  noise.model_m = 0.005;
+  noise.latch_px = 0.3;
+  return noise;
+}
+
+// The robot of TestRobotPose() with its height and tilt known: x, y, heading.
+inline PoseParameterisation RobotParameters() {
+  return PoseParameterisation(KnownHeightTilt{TestRobotPose().height, TestRobotPose().tilt});
+}
+
+// The solver's start: 2.2 cm and 0.3 degree from the truth.
+inline Eigen::Isometry3d Start(const Eigen::Isometry3d& truth) {
+  WorldTwist offset;
+  offset << 0.02, -0.01, 0.0, 0.0, 0.0, DegToRad(0.3);
+  return ApplyWorldTwist(truth, offset);
+}
+
 // The observations of `edges` (world) seen by `camera` from `cam_from_world`: each edge clipped
 // to the view, points every sample_step_px along its image (end_margin_px from the ends), each
 // moved along the image normal by point noise plus (1 - t) o_a + t o_b + l, o ~ N(0, (f s_m /

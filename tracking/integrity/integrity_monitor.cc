@@ -56,6 +56,107 @@ double BoundMultiplier(int dimension, double risk) {
   return std::sqrt(ChiSquareUpperQuantile(dimension, risk));
 }
 
+// The multipliers K of the protection levels (section 2.2): I/2 per quantity, of which half to
+// the fault-free case (a_ff = I/4) and half to the edges' faults, a_md = (I/4) / (n p); faults
+// need no monitoring when n p <= I/4.
+struct RiskMultipliers {
+  double fault_free_position, fault_free_rotation, missed_position, missed_rotation;
+  bool monitor_faults;
+};
+RiskMultipliers RiskMultipliersOf(const IntegrityOptions& options, const Blocks& b, size_t edges) {
+  const double per_quantity = 0.5 * options.integrity_risk;
+  const double fault_risk = 0.5 * per_quantity;
+  const double fault_prior = options.edge_fault_probability * edges;
+  const bool monitor_faults = fault_prior > fault_risk;
+  RiskMultipliers k{BoundMultiplier(b.position_size, 0.5 * per_quantity),
+                    BoundMultiplier(b.rotation_size, 0.5 * per_quantity), 0.0, 0.0, monitor_faults};
+  if (monitor_faults) {
+    k.missed_position = BoundMultiplier(b.position_size, fault_risk / fault_prior);
+    k.missed_rotation = BoundMultiplier(b.rotation_size, fault_risk / fault_prior);
+  }
+  return k;
+}
+
+// The state of `solution` minus that of `reference`: the unknowns' Difference, then the estimated
+// parameters' deviations (the same parameters in both).
+Eigen::VectorXd StateDifference(const EdgePoseSolution& solution,
+                                const EdgePoseSolution& reference) {
+  const int dof = solution.parameters.dof();
+  Eigen::VectorXd d(solution.state_size());
+  d.head(dof) = solution.parameters.Difference(solution.cam_from_world, reference.cam_from_world);
+  d.tail(solution.estimated.size()) = solution.parameter_deviation - reference.parameter_deviation;
+  return d;
+}
+
+// `solution` without its edge block `index`, downdated at the same linearisation point: the
+// information, gradient and coupling of the other edges (and the priors), their covariance.
+EdgePoseSolution WithoutEdge(const EdgePoseSolution& solution, int index) {
+  EdgePoseSolution out = solution;
+  const EdgeBlock& block = solution.edges[index];
+  out.information -= block.information;
+  out.gradient -= block.gradient;
+  out.coupling -= block.coupling;
+  out.chi2 -= block.chi2;
+  out.points -= block.points;
+  out.edges.erase(out.edges.begin() + index);
+  out.state_covariance = ConsiderCovariance(out.information, out.coupling, out.considered);
+  out.covariance = out.state_covariance.topLeftCorner(out.parameters.dof(), out.parameters.dof());
+  out.ok = out.covariance.allFinite();
+  return out;
+}
+
+// True when some separation test exceeds its chi-square quantile at `risk` (per test).
+bool Refuted(const std::vector<EdgeSeparation>& separations, double risk) {
+  std::vector<double> thresholds;  // by test_dof, computed when first needed
+  for (const EdgeSeparation& s : separations) {
+    if (!s.observable || s.test_dof == 0) continue;
+    if (static_cast<int>(thresholds.size()) <= s.test_dof) thresholds.resize(s.test_dof + 1, -1.0);
+    double& threshold = thresholds[s.test_dof];
+    if (threshold < 0.0) threshold = ChiSquareUpperQuantile(s.test_dof, risk);
+    if (s.test > threshold) return true;
+  }
+  return false;
+}
+
+// After an exclusion the frame has shown a faulty edge, and faults cluster (a door's jambs latch
+// on their casings together): the levels of each pair k, m of the edges left faulty together,
+// |x* - x_-km| + K sigma_max(P_-km) (downdated, as SolutionSeparations), K at the faults' share
+// I/4 over the pairs' prior C(m, 2) p^2; infinite when the others do not fix the pose.
+void PairFaultLevels(const EdgePoseSolution& solution, const IntegrityOptions& options,
+                     const Blocks& b, ProtectionLevels* pl) {
+  const int m = static_cast<int>(solution.edges.size());
+  const double fault_risk = 0.25 * options.integrity_risk;
+  const double p = options.edge_fault_probability;
+  const double pair_prior = 0.5 * m * (m - 1) * p * p;
+  if (!(pair_prior > fault_risk)) return;
+  const double k_position = BoundMultiplier(b.position_size, fault_risk / pair_prior);
+  const double k_rotation = BoundMultiplier(b.rotation_size, fault_risk / pair_prior);
+  const Eigen::MatrixXd& a = solution.information;
+  const Eigen::VectorXd optimum_shift = -a.ldlt().solve(solution.gradient);  // x_0* - x_0
+  for (int i = 0; i < m; ++i) {
+    for (int j = i + 1; j < m; ++j) {
+      const EdgeBlock &ei = solution.edges[i], &ej = solution.edges[j];
+      const Eigen::MatrixXd reduced = a - ei.information - ej.information;
+      const Eigen::MatrixXd covariance = ConsiderCovariance(
+          reduced, solution.coupling - ei.coupling - ej.coupling, solution.considered);
+      if (!covariance.allFinite()) {
+        pl->pair_fault_position_m = pl->pair_fault_rotation_rad = kInfinity;
+        return;
+      }
+      // x_0* - x_km, x_km = x_0 - A''^-1 (g - g_i - g_j).
+      const Eigen::VectorXd separation =
+          optimum_shift + reduced.ldlt().solve(solution.gradient - ei.gradient - ej.gradient);
+      const Eigen::Vector2d sigmas = LargestSigmas(solution.parameters, covariance);
+      pl->pair_fault_position_m = std::max(
+          pl->pair_fault_position_m,
+          separation.segment(b.position_start, b.position_size).norm() + k_position * sigmas[0]);
+      pl->pair_fault_rotation_rad = std::max(
+          pl->pair_fault_rotation_rad,
+          separation.segment(b.rotation_start, b.rotation_size).norm() + k_rotation * sigmas[1]);
+    }
+  }
+}
+
 std::string EdgeName(const std::vector<EdgeObservation>& observations, int k) {
   const int id = observations[k].model_edge >= 0 ? observations[k].model_edge : k;
   return "edge " + std::to_string(id);
@@ -120,15 +221,25 @@ void Judge(const IntegrityOptions& options, PoseIntegrity* out) {
   out->status =
       position_ok && rotation_ok ? IntegrityStatus::kTracking : IntegrityStatus::kDegraded;
   if (!std::isfinite(pl.position_m) || !std::isfinite(pl.rotation_rad)) {
-    Append(&out->reason, "a fault of one edge would go unnoticed");
+    Append(&out->reason, std::isfinite(pl.pair_fault_position_m)
+                             ? "a fault of one edge would go unnoticed"
+                             : "after an exclusion, a fault of two more edges would go unnoticed");
     return;
   }
   if (!position_ok) {
     // What sets the level: the fault-free bound or one edge's fault, and the start pose's offset.
-    const std::string limit =
+    std::string limit =
         pl.limiting_position_edge < 0
             ? "fault-free"
             : "an edge fault; fault-free " + Fixed(pl.fault_free_position_m, 3) + " m";
+    const double start = pl.start_offset_position_m;
+    if (pl.unrefuted_hypotheses > 0 && pl.wrong_exclusion_position_m + start >= pl.position_m) {
+      limit = "the exclusion may be wrong: " + std::to_string(pl.unrefuted_hypotheses) +
+              " hypotheses not refuted";
+    } else if (pl.pair_fault_position_m > 0.0 &&
+               pl.pair_fault_position_m + start >= pl.position_m) {
+      limit = "a fault of two more edges after an exclusion";
+    }
     Append(&out->reason, "position protection " + Fixed(pl.position_m, 3) + " m > " +
                              Fixed(options.alert_position_m, 3) + " m (" + limit + ", start +" +
                              Fixed(pl.start_offset_position_m, 3) + " m)");
@@ -161,10 +272,11 @@ bool IntegrityOptions::Check(std::string* why) const {
   }
   if (!(integrity_risk > 0.0 && integrity_risk < 0.5) ||
       !(false_alarm_probability > 0.0 && false_alarm_probability < 0.5) ||
+      !(exclusion_risk > 0.0 && exclusion_risk < 0.5) ||
       !(edge_fault_probability >= 0.0 && edge_fault_probability < 1.0) || !(fault_sigma_px > 0.0)) {
     *why =
-        "integrity: risk and false-alarm probability in (0, 0.5), fault probability in [0, 1), "
-        "fault sigma > 0";
+        "integrity: risk, false-alarm probability and exclusion risk in (0, 0.5), fault "
+        "probability in [0, 1), fault sigma > 0";
     return false;
   }
   if (max_exclusions < 0 || min_edges < 1) {
@@ -261,28 +373,22 @@ ProtectionLevels ComputeProtectionLevels(const EdgePoseSolution& solution,
                                          const std::vector<EdgeSeparation>& separations,
                                          const IntegrityOptions& options) {
   const Blocks b = BlocksOf(solution.parameters);
-  const double per_quantity = 0.5 * options.integrity_risk;
-  const double fault_risk = 0.5 * per_quantity;
-  const double fault_prior = options.edge_fault_probability * separations.size();
-  const bool monitor_faults = fault_prior > fault_risk;
-  const double missed = monitor_faults ? fault_risk / fault_prior : 1.0;
+  const RiskMultipliers k = RiskMultipliersOf(options, b, separations.size());
   ProtectionLevels pl;
   const Eigen::Vector2d sigmas = LargestSigmas(solution.parameters, solution.covariance);
-  pl.fault_free_position_m = BoundMultiplier(b.position_size, 0.5 * per_quantity) * sigmas[0];
-  pl.fault_free_rotation_rad = BoundMultiplier(b.rotation_size, 0.5 * per_quantity) * sigmas[1];
+  pl.fault_free_position_m = k.fault_free_position * sigmas[0];
+  pl.fault_free_rotation_rad = k.fault_free_rotation * sigmas[1];
   pl.position_m = pl.fault_free_position_m;
   pl.rotation_rad = pl.fault_free_rotation_rad;
-  if (!monitor_faults) return pl;
-  const double k_position = BoundMultiplier(b.position_size, missed);
-  const double k_rotation = BoundMultiplier(b.rotation_size, missed);
+  if (!k.monitor_faults) return pl;
   for (const EdgeSeparation& s : separations) {
     double position = kInfinity, rotation = kInfinity;
     if (s.observable) {
       const Eigen::Vector2d k_sigmas = LargestSigmas(solution.parameters, s.covariance);
-      position =
-          s.separation.segment(b.position_start, b.position_size).norm() + k_position * k_sigmas[0];
-      rotation =
-          s.separation.segment(b.rotation_start, b.rotation_size).norm() + k_rotation * k_sigmas[1];
+      position = s.separation.segment(b.position_start, b.position_size).norm() +
+                 k.missed_position * k_sigmas[0];
+      rotation = s.separation.segment(b.rotation_start, b.rotation_size).norm() +
+                 k.missed_rotation * k_sigmas[1];
     }
     if (position > pl.position_m) {
       pl.position_m = position;
@@ -296,6 +402,58 @@ ProtectionLevels ComputeProtectionLevels(const EdgePoseSolution& solution,
   return pl;
 }
 
+ProtectionLevels ExclusionProtectionLevels(const EdgePoseSolution& all_in,
+                                           const std::vector<EdgeSeparation>& all_in_separations,
+                                           const EdgePoseSolution& solution,
+                                           const std::vector<int>& excluded,
+                                           const ProtectionLevels& levels,
+                                           const IntegrityOptions& options) {
+  ProtectionLevels pl = levels;
+  if (excluded.empty()) return pl;
+  const Blocks b = BlocksOf(solution.parameters);
+  const int edges = static_cast<int>(all_in.edges.size());
+  const RiskMultipliers k = RiskMultipliersOf(options, b, edges);
+  // x - x_0*: the reported state from the all-in optimum (x_0* = x_0 - A^-1 g).
+  const Eigen::VectorXd offset =
+      StateDifference(solution, all_in) + all_in.information.ldlt().solve(all_in.gradient);
+  auto widen = [&](const Eigen::VectorXd& d, const Eigen::MatrixXd& covariance, double k_position,
+                   double k_rotation) {
+    const Eigen::Vector2d sigmas = LargestSigmas(solution.parameters, covariance);
+    pl.wrong_exclusion_position_m =
+        std::max(pl.wrong_exclusion_position_m,
+                 d.segment(b.position_start, b.position_size).norm() + k_position * sigmas[0]);
+    pl.wrong_exclusion_rotation_rad =
+        std::max(pl.wrong_exclusion_rotation_rad,
+                 d.segment(b.rotation_start, b.rotation_size).norm() + k_rotation * sigmas[1]);
+    ++pl.unrefuted_hypotheses;
+  };
+  // No faulty edge: the all-in tests are chi2 under it; refuted at exclusion_risk / edges each.
+  if (!Refuted(all_in_separations, options.exclusion_risk / edges)) {
+    widen(offset, all_in.state_covariance, k.fault_free_position, k.fault_free_rotation);
+  }
+  // Edge j faulty: x_-j is fault-free, and so are the separations of its edges (refuted at
+  // exclusion_risk / (n p) shared by its n - 1 tests: the union over the hypotheses).
+  const double fault_prior = options.edge_fault_probability * edges;
+  const double refutation =
+      options.exclusion_risk / std::max(1.0, fault_prior) / std::max(1, edges - 1);
+  for (int j = 0; k.monitor_faults && j < edges; ++j) {
+    const EdgeSeparation& s = all_in_separations[j];
+    // A critical edge: the subset's own levels are unbounded already.
+    if (!s.observable) continue;
+    if (Refuted(SolutionSeparations(WithoutEdge(all_in, j), options), refutation)) continue;
+    widen(offset + s.separation, s.covariance, k.missed_position, k.missed_rotation);
+  }
+  PairFaultLevels(solution, options, b, &pl);
+  const double position = std::max(pl.wrong_exclusion_position_m, pl.pair_fault_position_m);
+  if (position > pl.position_m) {
+    pl.position_m = position;
+    pl.limiting_position_edge = -1;
+  }
+  pl.rotation_rad =
+      std::max({pl.rotation_rad, pl.wrong_exclusion_rotation_rad, pl.pair_fault_rotation_rad});
+  return pl;
+}
+
 PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observations,
                                     const CameraIntrinsics& camera, const Eigen::Isometry3d& start,
                                     const PoseParameterisation& parameters,
@@ -305,6 +463,9 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
   std::vector<bool> excluded(observations.size(), false);
   Eigen::Isometry3d pose = start;
   std::vector<EdgeSeparation> separations;
+  // The all-in solution and its separations, kept when an edge is excluded (a wrong exclusion).
+  EdgePoseSolution all_in;
+  std::vector<EdgeSeparation> all_in_separations;
   for (int attempt = 0;; ++attempt) {
     out.solution =
         SolveEdgePose(observations, camera, pose, parameters, options.solver, excluded, prior);
@@ -336,11 +497,17 @@ PoseIntegrity EvaluatePoseIntegrity(const std::vector<EdgeObservation>& observat
       Append(&out.reason, fault + " after " + std::to_string(attempt) + " exclusions");
       return out;
     }
+    if (attempt == 0) {
+      all_in = out.solution;
+      all_in_separations = separations;
+    }
     excluded[worst->observation] = true;
     out.excluded.push_back(worst->observation);
     Append(&out.reason, fault + ", excluded");
   }
   out.levels = ComputeProtectionLevels(out.solution, separations, options);
+  out.levels = ExclusionProtectionLevels(all_in, all_in_separations, out.solution, out.excluded,
+                                         out.levels, options);
   FaultProbabilities(out.solution, options, &separations);
   const Eigen::MatrixXd state_covariance = FaultAwareCovariance(out.solution, separations);
   out.covariance = state_covariance.topLeftCorner(parameters.dof(), parameters.dof());

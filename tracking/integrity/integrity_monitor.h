@@ -38,6 +38,11 @@ struct IntegrityOptions {
   // Spread of a fault's offsets at the edge's two ends (pixels, each): the twin line of a door
   // casing a few centimetres away at 2-5 m. Weighs the evidence for a fault (Bayes factor).
   double fault_sigma_px = 3.0;
+  // After an exclusion, a hypothesis the exclusion may have got wrong (no faulty edge, or another
+  // edge faulty) is dropped from the protection levels only when the separation tests of its
+  // fault-free edges fail at this level: the probability per pose of dropping a true one
+  // (docs/integrity.md, section 2.3).
+  double exclusion_risk = 1e-4;
   int max_exclusions = 2;  // edges the fault test may exclude before the pose is lost
   int min_edges = 3;
   // true: the levels bound the error of the start pose (the tracker's own, which is reported)
@@ -100,10 +105,32 @@ struct ProtectionLevels {
   // With bound_start_pose: the start pose's distance from the solution, included in the levels.
   double start_offset_position_m = 0.0;
   int limiting_rotation_edge = -1;
+  // After an exclusion (ExclusionProtectionLevels): the largest levels of the hypotheses that
+  // the exclusion may have got wrong and the data do not refute, and how many there are.
+  double wrong_exclusion_position_m = 0.0;
+  double wrong_exclusion_rotation_rad = 0.0;
+  int unrefuted_hypotheses = 0;
+  // After an exclusion: the largest levels of two more edges faulty together (infinite when the
+  // others do not fix the pose without them).
+  double pair_fault_position_m = 0.0;
+  double pair_fault_rotation_rad = 0.0;
 };
 ProtectionLevels ComputeProtectionLevels(const EdgePoseSolution& solution,
                                          const std::vector<EdgeSeparation>& separations,
                                          const IntegrityOptions& options);
+
+// The protection levels of `solution`, reached from the all-in solution `all_in` by excluding the
+// observations `excluded` (docs/integrity.md, section 2.3). A wrong exclusion: each hypothesis h
+// of the all-in edges (none faulty: x_h = x_0; edge k faulty: x_h = x_-k) that the separation
+// tests of x_h's own edges do not refute at exclusion_risk adds |x - x_h| + K_h sigma_max(P_h).
+// More faults: each pair of the edges left adds |x - x_-km| + K sigma_max(P_-km). `levels` (the
+// subset's own, ComputeProtectionLevels) only grow; unchanged without an exclusion.
+ProtectionLevels ExclusionProtectionLevels(const EdgePoseSolution& all_in,
+                                           const std::vector<EdgeSeparation>& all_in_separations,
+                                           const EdgePoseSolution& solution,
+                                           const std::vector<int>& excluded,
+                                           const ProtectionLevels& levels,
+                                           const IntegrityOptions& options);
 
 // A tracked pose with its covariance, protection levels and status.
 struct PoseIntegrity {
