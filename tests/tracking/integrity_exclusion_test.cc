@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <random>
 
@@ -59,81 +60,89 @@ double AllowedFailures(double risk, int n) {
   return std::max(1.0, risk * n + 3.0 * std::sqrt(risk * n));
 }
 
-// Each draw: a seeded room, one edge in turn with one of kFaultsPx. The levels after an
-// exclusion hold the truth at the stated rate (integrity risk plus twice the exclusion risk per
-// pose) and are never below the subset's own (the excluded edges left out, as if never seen).
-TEST(IntegrityExclusion, LevelsAfterAnExclusionBoundTheErrorAtTheStatedRate) {
+struct Tally {
+  int poses = 0, tracking = 0, with_exclusion = 0, failures = 0, subset_failures = 0;
+};
+
+// Runs kDraws seeded rooms, draw d with the faults shift_of(d) (pixels per edge), and counts the
+// poses, their exclusions and integrity failures; the levels after an exclusion are never below
+// the subset's own (the excluded edges left out, as if never seen), whose failures are counted.
+Tally RunDraws(const std::function<std::vector<double>(int)>& shift_of, unsigned seed_base) {
   const CameraIntrinsics camera = TestCamera();
   const Eigen::Isometry3d truth = CamFromWorld(TestRobotPose());
   const std::vector<Segment3> edges = RoomEdges();
   const IntegrityOptions options = MonteCarloOptions();
-  int poses = 0, with_exclusion = 0, failures = 0, subset_failures = 0, tracking = 0;
+  Tally t;
   for (int draw = 0; draw < kDraws; ++draw) {
-    std::vector<double> shift(edges.size(), 0.0);
-    shift[draw % edges.size()] = kFaultsPx[(draw / edges.size()) % kFaultsPx.size()];
-    std::mt19937 random(1000 + draw);
+    std::mt19937 random(seed_base + draw);
     const std::vector<EdgeObservation> observations =
-        Observe(edges, camera, truth, RealisticNoise(), &random, shift);
+        Observe(edges, camera, truth, RealisticNoise(), &random, shift_of(draw));
     const PoseIntegrity p =
         EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
     if (p.status == IntegrityStatus::kLost) continue;
-    ++poses;
-    tracking += p.status == IntegrityStatus::kTracking;
-    failures += Fails(p.solution.cam_from_world, truth, p.levels);
+    ++t.poses;
+    t.tracking += p.status == IntegrityStatus::kTracking;
+    t.failures += Fails(p.solution.cam_from_world, truth, p.levels);
     if (p.excluded.empty()) {
       EXPECT_EQ(p.levels.unrefuted_hypotheses, 0);
       continue;
     }
-    ++with_exclusion;
+    ++t.with_exclusion;
     const ProtectionLevels subset =
         ComputeProtectionLevels(p.solution, SolutionSeparations(p.solution, options), options);
     EXPECT_GE(p.levels.position_m, subset.position_m);
     EXPECT_GE(p.levels.rotation_rad, subset.rotation_rad);
-    subset_failures += Fails(p.solution.cam_from_world, truth, subset);
+    t.subset_failures += Fails(p.solution.cam_from_world, truth, subset);
   }
-  const double stated = options.integrity_risk + 2.0 * options.exclusion_risk;
-  std::cout << "one fault: poses " << poses << " (tracking " << tracking << "), with an exclusion "
-            << with_exclusion << "; integrity failures " << failures
-            << ", with the subset's own levels " << subset_failures << " (allowed "
-            << AllowedFailures(stated, poses) << ")\n";
-  ASSERT_GT(with_exclusion, poses / 10);
-  EXPECT_LE(failures, AllowedFailures(stated, poses));
+  return t;
+}
+
+// The risk the levels after an exclusion are stated at: the integrity risk plus twice the
+// exclusion risk per pose.
+double StatedRisk() {
+  const IntegrityOptions options = MonteCarloOptions();
+  return options.integrity_risk + 2.0 * options.exclusion_risk;
+}
+
+// Each draw: a seeded room, one edge in turn with one of kFaultsPx. The levels after an
+// exclusion hold the truth at the stated rate.
+TEST(IntegrityExclusion, LevelsAfterAnExclusionBoundTheErrorAtTheStatedRate) {
+  const size_t edges = RoomEdges().size();
+  const Tally t = RunDraws(
+      [&](int draw) {
+        std::vector<double> shift(edges, 0.0);
+        shift[draw % edges] = kFaultsPx[(draw / edges) % kFaultsPx.size()];
+        return shift;
+      },
+      1000);
+  std::cout << "one fault: poses " << t.poses << " (tracking " << t.tracking
+            << "), with an exclusion " << t.with_exclusion << "; integrity failures " << t.failures
+            << ", with the subset's own levels " << t.subset_failures << " (allowed "
+            << AllowedFailures(StatedRisk(), t.poses) << ")\n";
+  ASSERT_GT(t.with_exclusion, t.poses / 10);
+  EXPECT_LE(t.failures, AllowedFailures(StatedRisk(), t.poses));
 }
 
 // Two jambs of the same side of two doors latched the same way (onto their casings): agreeing
 // faults that no single edge's separation shows. After an exclusion the levels, which cover two
 // more faulty edges, hold the truth at the stated rate (the subset's own levels are printed).
 TEST(IntegrityExclusion, LevelsAfterAnExclusionBoundTwoAgreeingFaults) {
-  const CameraIntrinsics camera = TestCamera();
-  const Eigen::Isometry3d truth = CamFromWorld(TestRobotPose());
-  const std::vector<Segment3> edges = RoomEdges();
-  const IntegrityOptions options = MonteCarloOptions();
-  int poses = 0, with_exclusion = 0, failures = 0, subset_failures = 0;
-  for (int draw = 0; draw < kDraws; ++draw) {
-    const std::array<int, 2>& pair = kSameSideJambs[draw % kSameSideJambs.size()];
-    std::vector<double> shift(edges.size(), 0.0);
-    shift[pair[0]] = shift[pair[1]] =
-        kPairFaultsPx[(draw / kSameSideJambs.size()) % kPairFaultsPx.size()];
-    std::mt19937 random(7000 + draw);
-    const std::vector<EdgeObservation> observations =
-        Observe(edges, camera, truth, RealisticNoise(), &random, shift);
-    const PoseIntegrity p =
-        EvaluatePoseIntegrity(observations, camera, Start(truth), RobotParameters(), options);
-    if (p.status == IntegrityStatus::kLost) continue;
-    ++poses;
-    failures += Fails(p.solution.cam_from_world, truth, p.levels);
-    if (p.excluded.empty()) continue;
-    ++with_exclusion;
-    subset_failures += Fails(
-        p.solution.cam_from_world, truth,
-        ComputeProtectionLevels(p.solution, SolutionSeparations(p.solution, options), options));
-  }
-  const double stated = options.integrity_risk + 2.0 * options.exclusion_risk;
-  std::cout << "two agreeing faults: poses " << poses << ", with an exclusion " << with_exclusion
-            << "; integrity failures " << failures << ", with the subset's own levels "
-            << subset_failures << " (allowed " << AllowedFailures(stated, poses) << ")\n";
-  ASSERT_GT(with_exclusion, poses / 10);
-  EXPECT_LE(failures, AllowedFailures(stated, poses));
+  const size_t edges = RoomEdges().size();
+  const Tally t = RunDraws(
+      [&](int draw) {
+        const std::array<int, 2>& pair = kSameSideJambs[draw % kSameSideJambs.size()];
+        std::vector<double> shift(edges, 0.0);
+        shift[pair[0]] = shift[pair[1]] =
+            kPairFaultsPx[(draw / kSameSideJambs.size()) % kPairFaultsPx.size()];
+        return shift;
+      },
+      7000);
+  std::cout << "two agreeing faults: poses " << t.poses << ", with an exclusion "
+            << t.with_exclusion << "; integrity failures " << t.failures
+            << ", with the subset's own levels " << t.subset_failures << " (allowed "
+            << AllowedFailures(StatedRisk(), t.poses) << ")\n";
+  ASSERT_GT(t.with_exclusion, t.poses / 10);
+  EXPECT_LE(t.failures, AllowedFailures(StatedRisk(), t.poses));
 }
 
 // A floor line latched 4 px is excluded; every hypothesis that the exclusion was wrong is refuted
