@@ -33,12 +33,19 @@ void CameraMountSourceOptions::Check() const {
   if (has_height) CheckRange(height, 0.0, 100.0, "--height");
   if (has_tilt) CheckRange(RadToDeg(tilt), -89.0, 89.0, "--tilt");
   const char* no_height = "ros: no camera height: give --height or the parameter ~height";
+  const bool has_mount = !mount.empty();
+  if (has_mount && Resolved() != HeadSource::kJointStates) {
+    throw InputError(
+        "ros: --mount (~mount) applies to the head's joint_states: give --pan-joint or "
+        "--tilt-joint, not --head tf or fixed");
+  }
   switch (Resolved()) {
     case HeadSource::kJointStates:
       if (pan_joint.empty() && tilt_joint.empty()) {
         throw InputError("ros: --head joint_states needs --pan-joint or --tilt-joint");
       }
-      if (!has_height) throw InputError(no_height);
+      // With a mount file, its floor height or --height (BelieveHead says which is missing).
+      if (!has_height && !has_mount) throw InputError(no_height);
       if (tilt_joint.empty() && !has_tilt) {
         throw InputError("ros: no tilt: give --tilt (or ~tilt), or a tilt joint (~tilt_joint)");
       }
@@ -70,6 +77,11 @@ CameraMountSource::CameraMountSource(const CameraMountSourceOptions& options,
   if (source == HeadSource::kTf || source == HeadSource::kAuto) {
     buffer_ = std::make_unique<tf2_ros::Buffer>();
     listener_ = std::make_unique<tf2_ros::TransformListener>(*buffer_, nh);
+  }
+  if (!options_.mount.empty()) {
+    const std::optional<double> taped =
+        std::isfinite(options_.height) ? std::optional<double>(options_.height) : std::nullopt;
+    head_ = BelieveHead(HeadModel::kPtu46, ReadMountFile(options_.mount), options_.mount, taped);
   }
 }
 
@@ -112,8 +124,12 @@ std::optional<CameraMount> CameraMountSource::FromJoints(double t, std::string* 
     return std::nullopt;
   }
   CameraMount mount = Fixed();
-  mount.pan = angles->pan;
-  mount.tilt = angles->tilt;
+  if (head_) {
+    mount = MountOnHead(head_->geometry, head_->crossing_height, angles->pan, angles->tilt);
+  } else {
+    mount.pan = angles->pan;
+    mount.tilt = angles->tilt;
+  }
   if (!mount.Check(why)) {
     *why = "joint_states of " + options_.pan_joint + " " + options_.tilt_joint + ": " + *why;
     return std::nullopt;

@@ -1,5 +1,6 @@
 // Where the camera is on the base at an image's stamp, for `linetrack ros`: from the pan-tilt
-// head's joint_states (pan and tilt joints named by parameters, the height given), from TF
+// head's joint_states (pan and tilt joints named by parameters, the height given, or the camera's
+// calibrated mount on the head from mount.json), from TF
 // base -> camera (the camera's frame from the image header, looked up at the image's stamp), or
 // fixed (the height and tilt given, the camera above the base's origin looking forward).
 #pragma once
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "app/head_mount.h"
 #include "app/ros/ros_geometry.h"
 
 namespace linetrack::app {
@@ -34,6 +36,10 @@ struct CameraMountSourceOptions {
   double height = std::numeric_limits<double>::quiet_NaN();  // m; NaN: not given
   double tilt = std::numeric_limits<double>::quiet_NaN();    // radians; NaN: not given
   std::string pan_joint, tilt_joint;  // joint_states names; empty: no such joint
+  // mount.json (calibration/mount_file.h) for joint_states: the camera on the head's tilt frame,
+  // the axes' crossing at the base's origin, at the file's floor height or `height` taped with the
+  // head level. Empty: the camera's centre at the base's origin, no head offsets.
+  std::string mount;
   std::string base_frame = "base_link";
   std::string camera_frame;  // empty: the image header's frame_id
   double wait = 0.05;        // s an image waits for TF to reach its stamp
@@ -43,13 +49,15 @@ struct CameraMountSourceOptions {
   // The source in use once `auto` is resolved for the joints: kJointStates, kTf or kAuto (TF
   // when TF links the frames, else fixed).
   HeadSource Resolved() const;
-  // Throws InputError naming the parameter when the chosen source lacks a value.
+  // Throws InputError naming the parameter when the chosen source lacks a value, or when a mount
+  // file is given for a source other than joint_states.
   void Check() const;
 };
 
 class CameraMountSource {
  public:
-  // Listens to TF on `nh` when the source may use it.
+  // Listens to TF on `nh` when the source may use it; reads the mount file (InputError naming it
+  // when it is bad, or when it has no floor height and no height is given).
   CameraMountSource(const CameraMountSourceOptions& options, const ros::NodeHandle& nh);
   ~CameraMountSource();
 
@@ -76,6 +84,7 @@ class CameraMountSource {
   mutable std::mutex mutex_;  // the joint angles and the last source
   std::condition_variable joints_arrived_;
   std::vector<StampedHeadAngles> joints_;  // sorted by time
+  std::optional<BelievedHead> head_;       // with a mount file
   std::string last_source_;
 };
 

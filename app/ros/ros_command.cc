@@ -95,11 +95,15 @@ void AddRos(CLI::App& cli, CommandAction* action) {
        "Head angles from: auto (joint_states when a joint is named, else TF base -> camera when "
        "TF links them, else --height/--tilt), joint_states, tf or fixed (~head, default auto)");
   flag("--height", "height", &o.height,
-       "Camera height above the base's origin, metres, without TF (~height)");
+       "Camera height above the base's origin, metres, without TF; with --mount, taped with the "
+       "head level, and optional when the mount file has a floor height (~height)");
   flag("--tilt", "tilt", &o.tilt_deg,
        "Camera tilt below the horizontal without a tilt joint or TF, degrees (~tilt)");
   flag("--pan-joint", "pan_joint", &o.pan_joint, "Pan joint in joint_states (~pan_joint)");
   flag("--tilt-joint", "tilt_joint", &o.tilt_joint, "Tilt joint in joint_states (~tilt_joint)");
+  flag("--mount", "mount", &o.mount,
+       "mount.json of calibrate-mount: the camera's calibrated mount on the head, with the "
+       "joint_states angles, the axes' crossing at the base's origin (~mount)");
   flag("--alert-limit", "alert_limit", &o.integrity.alert_limit,
        "METRES,DEGREES: a pose is 'tracking' (on ~pose) only when its protection levels are "
        "within it, else 'degraded' (~pose_degraded) (~alert_limit, default 0.10,2)");

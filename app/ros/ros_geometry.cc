@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "models/geometry.h"
+#include "tracking/head/head_pointing.h"
 #include "tracking/integrity/ros_covariance.h"
 
 namespace linetrack::app {
@@ -42,6 +43,15 @@ CameraMount MountOfBaseFromCamera(const Eigen::Isometry3d& base_from_cam) {
   mount.y = base_from_cam.translation().y();
   mount.height = base_from_cam.translation().z();
   return mount;
+}
+
+CameraMount MountOnHead(const HeadGeometry& geometry, double crossing_height, double pan,
+                        double tilt) {
+  // The camera's pose with the base at the world's origin: the world is then the base frame, and
+  // CamFromWorld(pose)^-1 has the rotation CamFromWorldRotation(heading, tilt)^T Rz(roll) of
+  // BaseFromCamera, so the fields carry over one to one.
+  const RobotPose camera = CameraPoseOnHead(geometry, Pose3Dof{}, crossing_height, pan, tilt);
+  return CameraMount{camera.height, camera.heading, camera.tilt, camera.x, camera.y, camera.roll};
 }
 
 Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose) {

@@ -11,6 +11,7 @@
 
 #include "matching/localizer.h"
 #include "models/robot_pose.h"
+#include "tracking/head/head_kinematics.h"
 #include "tracking/integrity/integrity_monitor.h"
 #include "tracking/tracker/relocalizer.h"
 
@@ -41,6 +42,12 @@ Eigen::Isometry3d BaseFromCamera(const CameraMount& mount);
 // tilt from the optical axis f = R e_z (pan = atan2(f_y, f_x), tilt = -asin(f_z)), roll from the
 // image's x axis in the level frame of that axis.
 CameraMount MountOfBaseFromCamera(const Eigen::Isometry3d& base_from_cam);
+
+// The mount of a camera on a pan-tilt head whose axes cross `crossing_height` metres above the
+// base's origin, at joint angles (pan, tilt): the base_from_cam T(0, 0, crossing_height)
+// level_from_base Rz(pan) Ry(tilt) tilt_from_camera (head_kinematics.h) read as a CameraMount.
+CameraMount MountOnHead(const HeadGeometry& geometry, double crossing_height, double pan,
+                        double tilt);
 
 // A planar base pose (x, y, yaw about z) as an isometry of the plane z = 0.
 Eigen::Isometry3d PlanarIsometry(const Pose3Dof& pose);

@@ -69,6 +69,7 @@ CameraMountSourceOptions RosNodeOptions::MountOptions() const {
   o.tilt = DegToRad(tilt_deg);
   o.pan_joint = pan_joint;
   o.tilt_joint = tilt_joint;
+  o.mount = mount;
   o.base_frame = base_frame;
   o.camera_frame = camera_frame;
   o.wait = odom_wait;
@@ -90,6 +91,7 @@ void ReadRosParameters(const ros::NodeHandle& nh, const std::vector<std::string>
   Param(nh, given, "tilt", &o->tilt_deg);
   Param(nh, given, "pan_joint", &o->pan_joint);
   Param(nh, given, "tilt_joint", &o->tilt_joint);
+  Param(nh, given, "mount", &o->mount);
   Param(nh, given, "transform_tolerance", &o->transform_tolerance);
   Param(nh, given, "odom_max_gap", &o->odom_max_gap);
   Param(nh, given, "odom_wait", &o->odom_wait);

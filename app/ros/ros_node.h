@@ -35,6 +35,7 @@ struct RosNodeOptions {
   double height = std::numeric_limits<double>::quiet_NaN();    // camera above the base (m)
   double tilt_deg = std::numeric_limits<double>::quiet_NaN();  // without a tilt joint or TF
   std::string pan_joint, tilt_joint;  // joint_states names; empty: no such joint
+  std::string mount;  // mount.json of the camera on the head (with joint_states); empty: none
   // ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma: the integrity monitor's
   IntegrityFlags integrity;
   double transform_tolerance = 0.1;  // s added to map -> odom's stamp, as AMCL does
@@ -53,7 +54,7 @@ struct RosNodeOptions {
 // Fills the options not given on the command line from the private parameters (~model,
 // ~camera, ~settings, ~map_frame, ~odom_frame, ~base_frame, ~camera_frame, ~head, ~height,
 // ~tilt, ~pan_joint,
-// ~tilt_joint, ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma,
+// ~tilt_joint, ~mount, ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma,
 // ~transform_tolerance, ~odom_max_gap, ~odom_wait). `given` names the
 // command-line flags given (without dashes, e.g. "model").
 void ReadRosParameters(const ros::NodeHandle& private_nh, const std::vector<std::string>& given,

@@ -7,9 +7,12 @@
 
 #include <array>
 
+#include "app/ros/camera_mount_source.h"
 #include "app/ros/newest_only.h"
 #include "app/ros/ros_tracker.h"
+#include "models/errors.h"
 #include "models/geometry.h"
+#include "models/pan_tilt.h"
 
 namespace linetrack::app {
 namespace {
@@ -82,6 +85,85 @@ TEST(RosGeometry, TheMountOfATransformComposesBackToIt) {
     const Eigen::Vector3d image_x = base_from_cam.linear().col(0);
     EXPECT_NEAR(image_x.z(), -std::sin(m.roll) * std::cos(m.tilt), kExact);
   }
+}
+
+// A calibrated camera on a pan-tilt head (76.5 mm left of, 10 mm ahead of and 68 mm above the
+// axes' crossing, turned 1 degree in yaw, pitch and roll off the tilt frame's axes, on a base
+// tilted 0.4 degrees in roll and -0.7 in pitch): the node's mount at joint angles (pan, tilt) is
+// base_from_camera = T(0, 0, h) level_from_base Rz(pan) Ry(tilt) tilt_from_camera, composed here
+// by hand, at several angles.
+TEST(RosGeometry, AMountOnTheHeadIsTheHeadsCameraPose) {
+  HeadGeometry head;
+  head.tilt_from_camera = AlignedMount(Eigen::Vector3d(0.010, 0.0765, 0.068), CameraRoll::kUpright);
+  head.tilt_from_camera.linear() = (Eigen::AngleAxisd(DegToRad(1.0), Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(DegToRad(-1.0), Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(DegToRad(1.0), Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix() *
+                                   head.tilt_from_camera.linear();
+  head.level_from_base = LevelFromBaseRotation(DegToRad(0.4), DegToRad(-0.7));
+  const double h = 1.23;
+  const std::array<std::array<double, 2>, 4> angles = {
+      {{25.0, 10.0}, {-40.0, -15.0}, {170.0, 30.0}, {0.0, 0.0}}};
+  for (const auto& [pan_deg, tilt_deg] : angles) {
+    const double pan = DegToRad(pan_deg), tilt = DegToRad(tilt_deg);
+    Eigen::Isometry3d expected = Eigen::Isometry3d::Identity();
+    expected.translation() = Eigen::Vector3d(0.0, 0.0, h);
+    expected.linear() = head.level_from_base *
+                        Eigen::AngleAxisd(pan, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                        Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    expected = expected * head.tilt_from_camera;
+    const CameraMount mount = MountOnHead(head, h, pan, tilt);
+    std::string why;
+    EXPECT_TRUE(mount.Check(&why)) << why;
+    EXPECT_TRUE(BaseFromCamera(mount).isApprox(expected, kExact))
+        << "pan " << pan_deg << " tilt " << tilt_deg << "\n"
+        << BaseFromCamera(mount).matrix() << "\n"
+        << expected.matrix();
+  }
+}
+
+// With the camera upright at the crossing on a level base, the mount is the node's mount without
+// a mount file: the joints' pan and tilt at the crossing's height.
+TEST(RosGeometry, ACameraAtTheCrossingHasTheJointsAngles) {
+  const HeadGeometry head;
+  const CameraMount mount = MountOnHead(head, 1.3, DegToRad(20.0), DegToRad(7.0));
+  EXPECT_NEAR(mount.height, 1.3, kExact);
+  EXPECT_NEAR(mount.pan, DegToRad(20.0), kExact);
+  EXPECT_NEAR(mount.tilt, DegToRad(7.0), kExact);
+  EXPECT_NEAR(mount.x, 0.0, kExact);
+  EXPECT_NEAR(mount.y, 0.0, kExact);
+  EXPECT_NEAR(mount.roll, 0.0, kExact);
+}
+
+// The InputError message of options.Check(), or "" when it does not throw.
+std::string CheckMessage(const CameraMountSourceOptions& options) {
+  try {
+    options.Check();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A mount file applies to the joints' angles: refused with TF or a fixed mount, and it makes the
+// height optional (its floor height, or BelieveHead asks for --height).
+TEST(RosMountOptions, AMountFileGoesWithJointStatesOnly) {
+  CameraMountSourceOptions o;
+  o.mount = "mount.json";
+  o.tilt = DegToRad(5.0);
+  for (HeadSource head : {HeadSource::kTf, HeadSource::kFixed, HeadSource::kAuto}) {
+    o.head = head;
+    o.height = 1.3;
+    EXPECT_NE(CheckMessage(o).find("--mount"), std::string::npos) << CheckMessage(o);
+  }
+  o.head = HeadSource::kAuto;
+  o.pan_joint = "head_pan";
+  o.height = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(CheckMessage(o), "");
+  o.head = HeadSource::kJointStates;
+  EXPECT_EQ(CheckMessage(o), "");
+  o.mount.clear();
+  EXPECT_NE(CheckMessage(o).find("--height"), std::string::npos) << CheckMessage(o);
 }
 
 TEST(RosGeometry, MapFromOdomComposesBackToTheTrackedBase) {

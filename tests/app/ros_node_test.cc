@@ -7,7 +7,8 @@
 // diagnostics come out. ~global_localization with no initial pose: the global mode finds the
 // robot, and the poses are checked alike. Then the same with the
 // head's angles and offset from TF base -> camera (static and dynamic transforms) instead of
-// --height and --tilt, and with them from joint_states and the camera from camera_info.
+// --height and --tilt, and with them from joint_states and the camera from camera_info; with
+// joint_states and a calibrated mount (mount.json) of a camera off the nominal geometry.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
@@ -19,15 +20,23 @@
 #include <std_msgs/String.h>
 #include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
+#include <nlohmann/json.hpp>
 
+#include <sys/wait.h>
+
+#include <algorithm>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <mutex>
 
 #include "app/ros/ros_geometry.h"
 #include "app/ros/ros_master.h"
 #include "app/ros/ros_messages.h"
+#include "calibration/mount_file.h"
+#include "models/pan_tilt.h"
 #include "tests/app/ros_test_scene.h"
+#include "tracking/head/head_pointing.h"
 
 namespace linetrack::app {
 namespace {
@@ -430,25 +439,14 @@ TEST(RosNodeTf, TakesTheHeadFromTfAtTheImageStamp) {
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
 }
 
-// The head's angles from joint_states (the pan and tilt joints named on the command line), the
-// head panning +-15 degrees: each image takes the angles at its stamp. The camera from
-// camera_info (no --camera).
-TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
-  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
-  NodeUnderTest node({"--odom-wait", "1", "--height", std::to_string(kHeight), "--pan-joint",
-                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints",
-                      "camera_info:=/camera/camera_info"});
-  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+// Drives `hall` through `node`, the head's angles on /robot/joints (head_pan, head_tilt) at each
+// image's stamp, from RViz's initial pose near the first frame, and checks the poses heard
+// against the truth.
+void DriveWithJointStates(NodeUnderTest& node, const test::RenderedDrive& hall) {
   ros::NodeHandle nh;
   ros::Publisher joints_pub = nh.advertise<sensor_msgs::JointState>("/robot/joints", 100);
-  ros::Publisher info_pub =
-      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, /*latch=*/true);
-  info_pub.publish(test::CameraInfoOf(ReadCameraXml(kCameraFile)));
   ASSERT_TRUE(node.Connected(/*tf=*/false)) << "the node did not connect";
-  ASSERT_TRUE(WaitFor(
-      [&] { return joints_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0; },
-      kDeadlineS));
-
+  ASSERT_TRUE(WaitFor([&] { return joints_pub.getNumSubscribers() > 0; }, kDeadlineS));
   const std::vector<Eigen::Isometry3d> map_from_base = PlanarMapFromBase(hall);
   const Eigen::Isometry3d odom_from_map = map_from_base[0].inverse();
   node.PublishInitialPose(hall.frames[0].base.Planar());
@@ -461,7 +459,149 @@ TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
         joints_pub.publish(joints);
       });
   ExpectPosesOfTheTruth(node.heard, stamps, map_from_base, odom_from_map);
+}
+
+// The head's angles from joint_states (the pan and tilt joints named on the command line), the
+// head panning +-15 degrees: each image takes the angles at its stamp. The camera from
+// camera_info (no --camera).
+TEST(RosNodeJoints, TakesTheHeadFromJointStatesAtTheImageStamp) {
+  const test::RenderedDrive hall = test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg));
+  NodeUnderTest node({"--odom-wait", "1", "--height", std::to_string(kHeight), "--pan-joint",
+                      "head_pan", "--tilt-joint", "head_tilt", "joint_states:=/robot/joints",
+                      "camera_info:=/camera/camera_info"});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  ros::NodeHandle nh;
+  ros::Publisher info_pub =
+      nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, /*latch=*/true);
+  info_pub.publish(test::CameraInfoOf(ReadCameraXml(kCameraFile)));
+  ASSERT_TRUE(WaitFor([&] { return info_pub.getNumSubscribers() > 0; }, kDeadlineS));
+  DriveWithJointStates(node, hall);
   EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
+}
+
+// The mount test's head: the camera 76.5 mm left of and 68 mm above the axes' crossing (ViSP's
+// PTU-46) but turned 1.2 degrees in yaw and 1 degree in pitch off the tilt frame's axes, on a base
+// tilted 0.5 degrees in pitch and -0.3 in roll; the crossing 1.232 m above the floor.
+constexpr double kMountYawDeg = 1.2;
+constexpr double kMountPitchDeg = 1.0;
+constexpr double kBasePitchDeg = 0.5;
+constexpr double kBaseRollDeg = -0.3;
+constexpr double kCrossingHeightM = kHeight - 0.068;
+
+HeadGeometry CalibratedHead() {
+  HeadGeometry head;
+  head.tilt_from_camera = AlignedMount(Eigen::Vector3d(0.0, 0.0765, 0.068), CameraRoll::kUpright);
+  head.tilt_from_camera.linear() =
+      (Eigen::AngleAxisd(DegToRad(kMountYawDeg), Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(DegToRad(kMountPitchDeg), Eigen::Vector3d::UnitY()))
+          .toRotationMatrix() *
+      head.tilt_from_camera.linear();
+  head.level_from_base = LevelFromBaseRotation(DegToRad(kBaseRollDeg), DegToRad(kBasePitchDeg));
+  return head;
+}
+
+// mount.json of `head` as calibrate-mount writes it, with a floor calibration (the crossing's
+// height and the base's tilt), in `dir`.
+std::string WriteMountJson(const HeadGeometry& head, const fs::path& dir) {
+  MountCalibration calibration;
+  calibration.status = MountStatus::kOk;
+  calibration.tilt_from_camera = head.tilt_from_camera;
+  calibration.covariance.diagonal().setConstant(1e-8);
+  MountRunInfo info;
+  info.camera_path = kCameraFile;
+  FloorCalibration floor;
+  floor.ok = true;
+  floor.floor = {kCrossingHeightM, DegToRad(kBaseRollDeg), DegToRad(kBasePitchDeg)};
+  info.floor = floor;
+  fs::create_directories(dir);
+  const std::string path = (dir / "mount.json").string();
+  std::ofstream(path) << MountJson(calibration, info);
+  return path;
+}
+
+// The head's angles from joint_states and the camera's calibrated mount on the head from --mount
+// (its floor height in place of --height): the frames rendered with the camera on that head, the
+// base poses must come back as in the joints test. The nominal geometry would put the camera 76.5
+// mm and 1.2 degrees off the truth.
+TEST(RosNodeMount, TakesTheCalibratedMountWithTheJointStates) {
+  const HeadGeometry head = CalibratedHead();
+  const test::RenderedDrive hall =
+      test::RenderHallDrive(kFrames, DegToRad(kTfPanAmplitudeDeg), [&](const SequenceFrame& f) {
+        return CamFromWorldOnHead(head, f.base.Planar(), kCrossingHeightM, f.pan, f.camera.tilt);
+      });
+  const fs::path dir =
+      fs::temp_directory_path() / ("linetrack_ros_mount_" + std::to_string(getpid()));
+  const std::string mount = WriteMountJson(head, dir);
+  NodeUnderTest node({"--odom-wait", "1", "--mount", mount, "--pan-joint", "head_pan",
+                      "--tilt-joint", "head_tilt", "joint_states:=/robot/joints", "--camera",
+                      kCameraFile});
+  ASSERT_TRUE(node.started()) << "roscore or the node did not start";
+  DriveWithJointStates(node, hall);
+  EXPECT_EQ(node.Stop(), 0) << "the node's exit status";
+  fs::remove_all(dir);
+}
+
+// What `linetrack ros` with `flags` did against the running master, once it exited.
+struct Refusal {
+  int exit_code = -1;   // -1: killed, or still running at the deadline
+  std::string stderr_;  // its whole stderr
+};
+
+// Runs `linetrack ros --model hall.cao --camera camera_wide.xml FLAGS` through the shell, its
+// stderr to `dir`/stderr.txt.
+Refusal RunRefused(const std::vector<std::string>& flags, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  std::string command = std::string("exec '") + LINETRACK_EXE + "' ros --model '" + kSource +
+                        "/models/hall.cao' --camera '" + kCameraFile + "'";
+  for (const std::string& flag : flags)
+    command += " '" + flag + "'";
+  command += " 2> '" + err.string() + "'";
+  ChildProcess node({"sh", "-c", command});
+  Refusal r;
+  if (!WaitFor([&] { return !node.Running(); }, kDeadlineS)) return r;
+  const int status = node.Stop();
+  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  std::ifstream in(err);
+  r.stderr_.assign(std::istreambuf_iterator<char>(in), {});
+  return r;
+}
+
+// One line on stderr, containing `what`, and exit 2.
+void ExpectRefused(const Refusal& r, const std::string& what) {
+  EXPECT_EQ(r.exit_code, 2) << r.stderr_;
+  EXPECT_EQ(std::count(r.stderr_.begin(), r.stderr_.end(), '\n'), 1) << r.stderr_;
+  EXPECT_NE(r.stderr_.find(what), std::string::npos) << r.stderr_;
+}
+
+// --mount with the head from TF or fixed, a mount file that is not one or is missing, and a mount
+// without a floor height nor --height: one line on stderr naming the flag or the file, exit 2.
+TEST(RosNodeMount, RefusesAMountItCannotUse) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("linetrack_ros_bad_" + std::to_string(getpid()));
+  RosCore core(dir / "ros");
+  ASSERT_TRUE(core.ready()) << "roscore did not start";
+  const std::string good = WriteMountJson(CalibratedHead(), dir);
+  const std::string bad = (dir / "bad.json").string();
+  std::ofstream(bad) << "{\"tilt_from_camera\": [1, 0, 0]}\n";
+  std::ifstream in(good);
+  nlohmann::json j = nlohmann::json::parse(in);
+  j.erase("floor");
+  const std::string no_floor = (dir / "no_floor.json").string();
+  std::ofstream(no_floor) << j.dump();
+  const std::string missing = (dir / "missing.json").string();
+  const std::vector<std::string> joints = {"--pan-joint", "head_pan", "--tilt-joint", "head_tilt"};
+  auto with_joints = [&](std::vector<std::string> flags) {
+    flags.insert(flags.end(), joints.begin(), joints.end());
+    return flags;
+  };
+  ExpectRefused(RunRefused({"--mount", good, "--head", "tf"}, dir), "--mount");
+  ExpectRefused(
+      RunRefused({"--mount", good, "--head", "fixed", "--height", "1.3", "--tilt", "5"}, dir),
+      "--mount");
+  ExpectRefused(RunRefused(with_joints({"--mount", bad}), dir), bad);
+  ExpectRefused(RunRefused(with_joints({"--mount", missing}), dir), missing);
+  ExpectRefused(RunRefused(with_joints({"--mount", no_floor}), dir), "--height");
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The rendered drive of the ROS tests: the bundled hall, the wide camera with radial distortion,
 // a robot driving the hall loop at 10 frames/s with the camera 1.3 m above its base, tilted 5
-// degrees down, the head panning by `pan_amplitude`, 5 unmodelled objects.
+// degrees down, the head panning by `pan_amplitude`, 5 unmodelled objects; optionally the camera
+// placed by the test (a camera on a head's calibrated mount).
 #pragma once
 
 #include <sensor_msgs/CameraInfo.h>
@@ -8,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -28,7 +30,11 @@ struct RenderedDrive {
   std::vector<vpImage<unsigned char>> images;
 };
 
-inline RenderedDrive RenderHallDrive(int count, double pan_amplitude) {
+// The drive; `place_camera`, when given, replaces each frame's cam_from_world (its base, pan and
+// tilt kept) before rendering.
+inline RenderedDrive RenderHallDrive(
+    int count, double pan_amplitude,
+    const std::function<Eigen::Isometry3d(const SequenceFrame&)>& place_camera = nullptr) {
   const std::string source = LINETRACK_SOURCE_DIR;
   const WireframeModel model = WireframeModel::Load(source + "/models/hall.cao");
   const CameraIntrinsics camera = ReadCameraXml(source + "/tests/data/camera_wide.xml");
@@ -43,6 +49,10 @@ inline RenderedDrive RenderHallDrive(int count, double pan_amplitude) {
   drive.pan_amplitude = pan_amplitude;
   RenderedDrive r;
   r.frames = DriveAlongLoop(LoopInsideArea(area), drive);
+  if (place_camera) {
+    for (SequenceFrame& frame : r.frames)
+      frame.cam_from_world = place_camera(frame);
+  }
   RenderOptions render;
   render.scene.clutter = 5;
   SceneRenderer renderer(model, camera, render, &area);
