@@ -112,6 +112,11 @@ void GrabFirstFrame(const ReplayOptions& opt, ReplaySetup* s) {
 // A recording (rosbag): its odometry is the prior file, --prior moves it to the map.
 void PrepareRecording(const ReplayOptions& opt, ReplaySetup* s) {
   if (!opt.open_recording) throw InputError(opt.input + ": this build cannot read rosbag files");
+  if (!opt.mount.empty()) {
+    throw InputError(
+        "replay: --mount applies to videos and image sequences; a bag's camera is "
+        "at --height with its joint states' angles");
+  }
   if (!opt.prior_file.empty()) throw InputError("replay: a bag's odometry replaces --prior-file");
   if (opt.recording.image_topic.empty()) throw InputError("replay: a bag needs --image-topic");
   if (!opt.has_height) throw InputError("replay: a bag needs --height");

@@ -102,10 +102,10 @@ class RosBagReplay : public test_support::CliTest {
            " --alert-limit " + kAlertLimit;
   }
 
-  void ExpectRejected(const fs::path& bag, const std::string& odom_topic,
-                      const std::string& named) {
+  void ExpectRejected(const fs::path& bag, const std::string& odom_topic, const std::string& named,
+                      const std::string& extra = "") {
     const fs::path out = dir_ / "out";
-    const test_support::CommandRun run = Linetrack(Args(bag, odom_topic, out));
+    const test_support::CommandRun run = Linetrack(Args(bag, odom_topic, out) + extra);
     EXPECT_EQ(run.code, 2) << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
     EXPECT_NE(run.err.find(named), std::string::npos) << run.err;
@@ -227,6 +227,8 @@ TEST_F(RosBagReplay, BadBagsExitTwoWithOneLineAndWriteNothing) {
   ExpectRejected(run.bag, "/wheel/odom", "/wheel/odom");      // missing topic
   ExpectRejected(run.bag, "/joint_states", "/joint_states");  // wrong message type
   ExpectRejected(dir_ / "absent.bag", "/robot/odom", "absent.bag");
+  // A calibrated mount is not yet applied to a bag's joint states: refused, not ignored.
+  ExpectRejected(run.bag, "/robot/odom", "--mount", " --mount " + (dir_ / "mount.json").string());
 
   // Truncated: the first half of the file.
   const std::string bytes = test_support::ReadAll(run.bag);
