@@ -10,8 +10,7 @@ endfunction()
 # and scripts/demo.sh use: each target's files compiled as a few large translation units): they
 # define a file-local name that another file of the same target defines too.
 function(linetrack_unity_apart)
-  set_source_files_properties(${ARGN} DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}
-                              PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+  set_source_files_properties(${ARGN} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
 endfunction()
 
 # Precompiled headers: the third-party headers that most of the project's files include (Eigen in
