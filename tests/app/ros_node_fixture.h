@@ -79,8 +79,8 @@ inline int FrameOf(const std::vector<ros::Time>& stamps, const ros::Time& stamp)
 }
 
 // (x, y, yaw) of the published base pose minus the truth's.
-Eigen::Vector3d PlanarError(const geometry_msgs::PoseWithCovarianceStamped& pose,
-                            const Pose3Dof& truth) {
+inline Eigen::Vector3d PlanarError(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                                   const Pose3Dof& truth) {
   const Pose3Dof got = PlanarOf(ToIsometry(pose.pose.pose));
   return {got.x - truth.x, got.y - truth.y, WrapAngle(got.heading - truth.heading)};
 }
