@@ -17,7 +17,7 @@ namespace linetrack {
 struct GlobalOptions {
   HeadingOptions heading;
   // Peaks of the heading vote searched (best first), each with all its symmetric headings.
-  int max_heading_hypotheses = 2;
+  int max_heading_hypotheses = 6;
   // A weaker peak is searched only when it has at least this share of the best one's support.
   double min_support_share = 0.5;
   // Heading bound of each search: heading_sigmas x the peak's standard deviation, clamped to
@@ -29,6 +29,11 @@ struct GlobalOptions {
   // (PoseEvidence::Support): over the whole hall, a pose that explains part of the image by a
   // partial repetition of the building predicts edges the image does not have (docs/global.md).
   double min_support = 0.6;
+  // Explanations within near_m and near_deg of the best are the same place seen with the
+  // uncertainty of a few lines: within the ambiguity margin they widen the answer's covariance
+  // (NearSpreadCovariance) instead of making it ambiguous.
+  double near_m = 1.5;
+  double near_deg = 10.0;
   // The position vote of each heading search, and the local matcher's prior around each of its
   // peaks: delta_t (metres) and delta_phi (degrees).
   PositionVoteOptions vote;
