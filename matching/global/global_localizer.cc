@@ -34,6 +34,10 @@ bool GlobalOptions::Check(std::string* why) const {
     *why = "near_m and near_deg must be >= 0";
     return false;
   }
+  if (!(verify_budget_share > 0.0 && verify_budget_share <= 1.0)) {
+    *why = "verify_budget_share must be in (0, 1]";
+    return false;
+  }
   if (!(verify_delta_t_m > 0.0) || !(verify_delta_phi_deg > 0.0) || max_verified_peaks < 1) {
     *why = "verify_delta_t_m, verify_delta_phi_deg and max_verified_peaks must be positive";
     return false;
@@ -46,6 +50,19 @@ GlobalOptions GlobalOptionsFor(const LocalizerOptions& localizer) {
   options.heading.line_angle_sigma_deg = localizer.noise.angle_deg;
   options.heading.line_offset_sigma_px = localizer.noise.offset_px;
   return options;
+}
+
+LocalizerOptions VerifierOptions(const LocalizerOptions& localizer, const GlobalOptions& options) {
+  LocalizerOptions out = localizer;
+  const double k = options.verify_budget_share;
+  const auto scaled = [k](auto budget) {
+    return std::max<decltype(budget)>(1, static_cast<decltype(budget)>(k * budget));
+  };
+  out.tree.max_nodes = scaled(out.tree.max_nodes);
+  out.tree.max_checks = scaled(out.tree.max_checks);
+  out.tree.max_hypotheses = scaled(out.tree.max_hypotheses);
+  out.verification.max_pair_tests = scaled(out.verification.max_pair_tests);
+  return out;
 }
 
 std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidates,
@@ -92,6 +109,8 @@ PositionVoteOptions VoteOptions(const GlobalOptions& options, const Localizer& l
 GlobalLocalizer::GlobalLocalizer(const Localizer& localizer, const ModelDirections& directions,
                                  const GlobalOptions& options)
     : localizer_(localizer),
+      verifier_(localizer.model(), nullptr, localizer.area(), localizer.camera(),
+                VerifierOptions(localizer.options(), options)),
       directions_(directions),
       options_(options),
       vote_(localizer.model(), AreaOf(localizer), VoteOptions(options, localizer)) {
@@ -109,6 +128,7 @@ LocalizationProblem GlobalLocalizer::PeakProblem(const GlobalProblem& problem,
   local.prior = {peak.position.x(), peak.position.y(), peak.heading};
   local.delta_t = options_.verify_delta_t_m;
   local.delta_phi = DegToRad(options_.verify_delta_phi_deg);
+  local.candidate_edges = localizer_.CandidateEdges(local);
   return local;
 }
 
@@ -140,7 +160,7 @@ GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
   if (static_cast<int>(peaks.size()) > options_.max_verified_peaks)
     peaks.resize(options_.max_verified_peaks);
   for (PeakVerification& v : peaks)
-    v.result = localizer_.Localize(PeakProblem(problem, v.peak));
+    v.result = verifier_.Localize(PeakProblem(problem, v.peak));
   out.verifications = std::move(peaks);
   DecideGlobal(localizer_.options().verification, options_, &out);
   return out;
