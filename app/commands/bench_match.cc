@@ -279,6 +279,14 @@ std::string Row(const std::string& matcher, const Tally& t) {
   return row.str();
 }
 
+// The heading vote's hypotheses for --diagnose: [heading_deg, sigma_deg, support, rms_sigmas].
+nlohmann::ordered_json HeadingHypothesesJson(const HeadingCandidates& headings) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const HeadingHypothesis& h : headings.hypotheses)
+    out.push_back({RadToDeg(h.heading), RadToDeg(h.heading_sigma), h.support, h.rms_sigmas});
+  return out;
+}
+
 // One scene of the global series for --diagnose: the truth verified by a peak's search centred on
 // the true pose (its evidence, as the matcher would score it) against every verified peak's
 // finalists, and how far the truth's heading is from the nearest search's.
@@ -322,6 +330,7 @@ nlohmann::ordered_json GlobalDiagnosisJson(const GlobalLocalizer& global, const 
           {"reason", r.reason},
           {"truth_pose", {scene.truth.x, scene.truth.y, RadToDeg(WrapAngle(scene.truth.heading))}},
           {"truth_heading_off_deg", nearest_deg},
+          {"heading_hypotheses", HeadingHypothesesJson(r.headings)},
           {"truth_plausible", d.plausible},
           {"truth_implausible_because", d.implausible_because},
           {"truth_matched_edges", d.matched_edges},

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "matching/pose_decision.h"
+#include "matching/global/global_decision.h"
 #include "models/errors.h"
 #include "models/geometry.h"
 
@@ -30,6 +30,14 @@ bool GlobalOptions::Check(std::string* why) const {
     *why = "min_support must be in [0, 1]";
     return false;
   }
+  if (!(near_m >= 0.0) || !(near_deg >= 0.0)) {
+    *why = "near_m and near_deg must be >= 0";
+    return false;
+  }
+  if (!(verify_budget_share > 0.0 && verify_budget_share <= 1.0)) {
+    *why = "verify_budget_share must be in (0, 1]";
+    return false;
+  }
   if (!(verify_delta_t_m > 0.0) || !(verify_delta_phi_deg > 0.0) || max_verified_peaks < 1) {
     *why = "verify_delta_t_m, verify_delta_phi_deg and max_verified_peaks must be positive";
     return false;
@@ -42,6 +50,19 @@ GlobalOptions GlobalOptionsFor(const LocalizerOptions& localizer) {
   options.heading.line_angle_sigma_deg = localizer.noise.angle_deg;
   options.heading.line_offset_sigma_px = localizer.noise.offset_px;
   return options;
+}
+
+LocalizerOptions VerifierOptions(const LocalizerOptions& localizer, const GlobalOptions& options) {
+  LocalizerOptions out = localizer;
+  const double k = options.verify_budget_share;
+  const auto scaled = [k](auto budget) {
+    return std::max<decltype(budget)>(1, static_cast<decltype(budget)>(k * budget));
+  };
+  out.tree.max_nodes = scaled(out.tree.max_nodes);
+  out.tree.max_checks = scaled(out.tree.max_checks);
+  out.tree.max_hypotheses = scaled(out.tree.max_hypotheses);
+  out.verification.max_pair_tests = scaled(out.verification.max_pair_tests);
+  return out;
 }
 
 std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidates,
@@ -66,77 +87,6 @@ std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidat
 
 namespace {
 
-// A finalist of one verification: its pose, evidence and whether that verification accepted it.
-struct Explanation {
-  Pose3Dof pose;
-  double score = 0.0;     // evidence (nats)
-  int search = -1;        // index into the verifications
-  bool accepted = false;  // the verification's own answer
-};
-
-// Every finalist of every verification (those that accepted no pose included: their best may be
-// the truth, too weakly seen), best first, one per distinct pose.
-std::vector<Explanation> Explanations(const std::vector<PeakVerification>& searches,
-                                      const VerificationOptions& vo) {
-  std::vector<Explanation> all;
-  for (size_t i = 0; i < searches.size(); ++i) {
-    const LocalizationResult& r = searches[i].result;
-    for (size_t k = 0; k < r.finalists.size(); ++k) {
-      all.push_back({r.finalists[k].pose, r.finalists[k].evidence.Score(), static_cast<int>(i),
-                     r.found && k == 0});
-    }
-  }
-  std::stable_sort(all.begin(), all.end(),
-                   [](const Explanation& a, const Explanation& b) { return a.score > b.score; });
-  std::vector<Explanation> distinct;
-  for (const Explanation& e : all) {
-    if (std::none_of(distinct.begin(), distinct.end(),
-                     [&](const Explanation& d) { return SamePose(d.pose, e.pose, vo); })) {
-      distinct.push_back(e);
-    }
-  }
-  return distinct;
-}
-
-// The answer from the searches: the best explanation when a search accepted it, no distinct
-// pose comes within the ambiguity margin and it observes min_support of its predicted outline;
-// "ambiguous" with the rivals when a distinct pose comes within the margin; else the reason.
-void Decide(const VerificationOptions& vo, double min_support, GlobalResult* out) {
-  const std::vector<Explanation> explanations = Explanations(out->verifications, vo);
-  if (explanations.empty()) {
-    out->reason = "no heading candidate's search found a plausible pose";
-    return;
-  }
-  const Explanation& best = explanations.front();
-  const LocalizationResult& best_search = out->verifications[best.search].result;
-  std::vector<Pose3Dof> rivals;
-  for (const Explanation& e : explanations) {
-    if (e.score > best.score - vo.ambiguity_nats) rivals.push_back(e.pose);
-  }
-  const double support =
-      best_search.finalists.empty() ? 0.0 : best_search.finalists.front().evidence.Support();
-  if (rivals.size() == 1 && best.accepted && support < min_support) {
-    out->reason = "the best pose observes " + std::to_string(static_cast<int>(100.0 * support)) +
-                  " % of its predicted outline (a partial explanation)";
-    return;
-  }
-  if (rivals.size() == 1 && best.accepted) {
-    out->found = true;
-    out->best = best_search;
-    return;
-  }
-  if (rivals.size() > 1) {
-    out->ambiguous = true;
-    out->rivals = rivals;
-    out->reason = "ambiguous: " + std::to_string(rivals.size()) +
-                  " distinct poses explain the image almost as well";
-    return;
-  }
-  out->reason = best_search.reason;
-  out->ambiguous = best_search.reason.rfind("ambiguous", 0) == 0;
-  if (out->ambiguous) out->rivals = rivals;
-}
-
 // The localizer's navigable area; throws InputError when it has none.
 const NavigableArea& AreaOf(const Localizer& localizer) {
   if (localizer.area() == nullptr) {
@@ -159,6 +109,8 @@ PositionVoteOptions VoteOptions(const GlobalOptions& options, const Localizer& l
 GlobalLocalizer::GlobalLocalizer(const Localizer& localizer, const ModelDirections& directions,
                                  const GlobalOptions& options)
     : localizer_(localizer),
+      verifier_(localizer.model(), nullptr, localizer.area(), localizer.camera(),
+                VerifierOptions(localizer.options(), options)),
       directions_(directions),
       options_(options),
       vote_(localizer.model(), AreaOf(localizer), VoteOptions(options, localizer)) {
@@ -176,6 +128,7 @@ LocalizationProblem GlobalLocalizer::PeakProblem(const GlobalProblem& problem,
   local.prior = {peak.position.x(), peak.position.y(), peak.heading};
   local.delta_t = options_.verify_delta_t_m;
   local.delta_phi = DegToRad(options_.verify_delta_phi_deg);
+  local.candidate_edges = localizer_.CandidateEdges(local);
   return local;
 }
 
@@ -207,9 +160,9 @@ GlobalResult GlobalLocalizer::Localize(const GlobalProblem& problem) const {
   if (static_cast<int>(peaks.size()) > options_.max_verified_peaks)
     peaks.resize(options_.max_verified_peaks);
   for (PeakVerification& v : peaks)
-    v.result = localizer_.Localize(PeakProblem(problem, v.peak));
+    v.result = verifier_.Localize(PeakProblem(problem, v.peak));
   out.verifications = std::move(peaks);
-  Decide(localizer_.options().verification, options_.min_support, &out);
+  DecideGlobal(localizer_.options().verification, options_, &out);
   return out;
 }
 

@@ -17,7 +17,7 @@ namespace linetrack {
 struct GlobalOptions {
   HeadingOptions heading;
   // Peaks of the heading vote searched (best first), each with all its symmetric headings.
-  int max_heading_hypotheses = 2;
+  int max_heading_hypotheses = 6;
   // A weaker peak is searched only when it has at least this share of the best one's support.
   double min_support_share = 0.5;
   // Heading bound of each search: heading_sigmas x the peak's standard deviation, clamped to
@@ -29,6 +29,11 @@ struct GlobalOptions {
   // (PoseEvidence::Support): over the whole hall, a pose that explains part of the image by a
   // partial repetition of the building predicts edges the image does not have (docs/global.md).
   double min_support = 0.6;
+  // Explanations within near_m and near_deg of the best are the same place seen with the
+  // uncertainty of a few lines: within the ambiguity margin they widen the answer's covariance
+  // (NearSpreadCovariance) instead of making it ambiguous.
+  double near_m = 1.5;
+  double near_deg = 10.0;
   // The position vote of each heading search, and the local matcher's prior around each of its
   // peaks: delta_t (metres) and delta_phi (degrees).
   PositionVoteOptions vote;
@@ -36,6 +41,10 @@ struct GlobalOptions {
   double verify_delta_phi_deg = 5.0;
   // The peaks verified: the best of all searches' peaks by votes.
   int max_verified_peaks = 24;
+  // The verifications' search budgets (the tree's nodes, checks and leaves, guided matching's
+  // pair tests) as a share of the local mode's: a peak's prior is small, and at a wrong peak the
+  // tree spends its whole budget finding nothing.
+  double verify_budget_share = 0.3;
 
   bool Check(std::string* why) const;
 };
@@ -77,6 +86,10 @@ struct GlobalResult {
 // deviations), so that both judge a segment alike.
 GlobalOptions GlobalOptionsFor(const LocalizerOptions& localizer);
 
+// The verifications' localizer options: `localizer`'s with its search budgets scaled by
+// options.verify_budget_share (at least 1 each).
+LocalizerOptions VerifierOptions(const LocalizerOptions& localizer, const GlobalOptions& options);
+
 // The searches' headings and bounds for heading candidates (pure: tested directly): the
 // hypotheses of `candidates` kept by `options`, each with its symmetric headings.
 std::vector<HeadingSearch> PlanHeadingSearches(const HeadingCandidates& candidates,
@@ -93,13 +106,14 @@ class GlobalLocalizer {
   GlobalResult Localize(const GlobalProblem& problem) const;
 
   // The local problem verifying one peak: the prior at the peak, options' verify_delta_t_m and
-  // verify_delta_phi_deg.
+  // verify_delta_phi_deg, the candidate edges of the localizer's view-invariant regions.
   LocalizationProblem PeakProblem(const GlobalProblem& problem, const PositionPeak& peak) const;
 
   const PositionVote& vote() const { return vote_; }
 
  private:
   const Localizer& localizer_;
+  Localizer verifier_;  // the localizer's model, area and camera; the budgets' share
   const ModelDirections& directions_;
   GlobalOptions options_;
   PositionVote vote_;

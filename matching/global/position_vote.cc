@@ -158,9 +158,13 @@ void PositionVote::Mark(const PositionLocus& locus, int stamp, std::vector<int>*
   }
   if (t0 > t1) return;
   const int steps = 1 + static_cast<int>(std::ceil(2.0 * (t1 - t0) * d.norm()));
+  int last_x = -2, last_y = -2;  // the previous sample's cell (outside the clipped grid)
   for (int s = 0; s <= steps; ++s) {
     const Eigen::Vector2d p = from + (t0 + (t1 - t0) * s / steps) * d;
     const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
+    if (cx == last_x && cy == last_y) continue;  // the same 3 x 3 neighbourhood, already marked
+    last_x = cx;
+    last_y = cy;
     for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x) {
         const int i = y * nx_ + x;

@@ -55,6 +55,25 @@ TEST(PlanHeadingSearches, EveryHeadingOfTheKeptPeaksWithItsClampedBound) {
   EXPECT_TRUE(PlanHeadingSearches(c, options).empty());
 }
 
+TEST(VerifierOptions, TheSearchBudgetsAreTheSharedOnesScaledAtLeastOne) {
+  LocalizerOptions local;
+  local.tree.max_nodes = 5000;
+  local.tree.max_checks = 100000;
+  local.tree.max_hypotheses = 2;
+  local.verification.max_pair_tests = 800000;
+  GlobalOptions options;
+  options.verify_budget_share = 0.3;
+  const LocalizerOptions v = VerifierOptions(local, options);
+  EXPECT_EQ(v.tree.max_nodes, 1500);
+  EXPECT_EQ(v.tree.max_checks, 30000);
+  EXPECT_EQ(v.tree.max_hypotheses, 1);  // 0.6 leaves: at least one
+  EXPECT_EQ(v.verification.max_pair_tests, 240000);
+  EXPECT_EQ(v.tree.max_lines, local.tree.max_lines);  // not a budget: unchanged
+  options.verify_budget_share = 0.0;
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+}
+
 TEST(GlobalOptions, CheckRejectsBadBounds) {
   GlobalOptions options;
   std::string why;
