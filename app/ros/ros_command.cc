@@ -112,6 +112,15 @@ void AddRos(CLI::App& cli, CommandAction* action) {
        "(~camera_sigma, default 0.003,1)");
   flag("--model-sigma", "model_sigma", &o.integrity.model_sigma_m,
        "Model error allowance, metres at each edge end (~model_sigma)");
+  flag("--kidnap-after-s", "kidnap_after_s", &o.global.kidnap_after_s,
+       "Global mode (the robot may have been carried away) after this many seconds of frames "
+       "the matcher around the odometry's prior cannot explain (~kidnap_after_s, default 0.3; "
+       "0: off)");
+  flag("--global-after-s", "global_after_s", &o.global.global_after_s,
+       "Global mode after this many seconds lost (~global_after_s, default 2.5; 0: off)");
+  flag("--global-after-m", "global_after_m", &o.global.global_after_m,
+       "Global mode after this many metres driven while lost (~global_after_m, default 3; 0: "
+       "off)");
   flag("--odom-wait", "odom_wait", &o.odom_wait,
        "Seconds an image waits for the odometry to reach its stamp (~odom_wait, default 0.05)");
   flag("--transform-tolerance", "transform_tolerance", &o.transform_tolerance,

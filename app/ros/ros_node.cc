@@ -54,6 +54,7 @@ void RosNodeOptions::Check() const {
   if (model.empty()) throw InputError("ros: no model: give --model or the parameter ~model");
   MountOptions().Check();
   integrity.Options();  // throws naming the flag
+  global.Options();
   CheckRange(transform_tolerance, 0.0, 10.0, "--transform-tolerance");
   CheckRange(odom_max_gap, 0.0, 10.0, "--odom-max-gap");
   CheckRange(odom_wait, 0.0, 1.0, "--odom-wait");
@@ -98,6 +99,9 @@ void ReadRosParameters(const ros::NodeHandle& nh, const std::vector<std::string>
   Param(nh, given, "alert_limit", &o->integrity.alert_limit);
   Param(nh, given, "camera_sigma", &o->integrity.camera_sigma);
   Param(nh, given, "model_sigma", &o->integrity.model_sigma_m);
+  Param(nh, given, "kidnap_after_s", &o->global.kidnap_after_s);
+  Param(nh, given, "global_after_s", &o->global.global_after_s);
+  Param(nh, given, "global_after_m", &o->global.global_after_m);
 }
 
 struct RosNode::Impl {
@@ -168,6 +172,7 @@ void RosNode::Impl::Setup() {
   tracker_options.settings =
       options.settings.empty() ? base : ReadTrackerSettings(options.settings, base);
   tracker_options.sequence.integrity = options.integrity.Options();
+  tracker_options.sequence.global = options.global.Options();
   global_available = tracker_options.sequence.global.enabled;
   mount_source = std::make_unique<CameraMountSource>(options.MountOptions(), nh);
   if (!options.camera.empty()) {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "app/global_mode_flags.h"
 #include "app/integrity_output.h"
 #include "app/ros/camera_mount_source.h"
 #include "app/ros/ros_geometry.h"
@@ -38,6 +39,9 @@ struct RosNodeOptions {
   std::string mount;  // mount.json of the camera on the head (with joint_states); empty: none
   // ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma: the integrity monitor's
   IntegrityFlags integrity;
+  // ~kidnap_after_s, ~global_after_s, ~global_after_m: when a lost robot switches to the global
+  // mode (seconds, metres; GlobalRecoveryOptions)
+  GlobalModeFlags global;
   double transform_tolerance = 0.1;  // s added to map -> odom's stamp, as AMCL does
   double odom_max_gap = 0.5;         // s: odometry this far from an image's stamp is not used
   // s: how long an image waits for the odometry to reach its stamp (odometry and images come on
@@ -55,8 +59,8 @@ struct RosNodeOptions {
 // ~camera, ~settings, ~map_frame, ~odom_frame, ~base_frame, ~camera_frame, ~head, ~height,
 // ~tilt, ~pan_joint,
 // ~tilt_joint, ~mount, ~alert_limit "METRES,DEGREES", ~camera_sigma, ~model_sigma,
-// ~transform_tolerance, ~odom_max_gap, ~odom_wait). `given` names the
-// command-line flags given (without dashes, e.g. "model").
+// ~kidnap_after_s, ~global_after_s, ~global_after_m, ~transform_tolerance, ~odom_max_gap,
+// ~odom_wait). `given` names the command-line flags given (without dashes, e.g. "model").
 void ReadRosParameters(const ros::NodeHandle& private_nh, const std::vector<std::string>& given,
                        RosNodeOptions* options);
 

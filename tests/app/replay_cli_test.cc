@@ -236,7 +236,10 @@ TEST_F(ReplayCli, HeightAndInapplicableFlagsAreBadInput) {
       {castle + " --delta-t 1", "--delta-t"},      // no robot: no matcher to bound
       {castle + " --detector lsd", "--detector"},  // nor to extract lines for
       {castle + " --prior-file p.csv --tilt 3", "--tilt"},
-      {castle + " --kidnap-after -1", "--kidnap-after"},
+      {castle + " --kidnap-after-s -1", "--kidnap-after-s"},
+      {castle + " --kidnap-after 3", "--kidnap-after-s"},  // the former frame count
+      {castle + " --global-after 25", "--global-after-s"},
+      {castle + " --global-after-s nan", "--global-after-s"},
       {castle + " --global-after-m nan", "--global-after-m"},
   };
   for (const auto& [args, flag] : bad) {
@@ -260,8 +263,9 @@ TEST_F(ReplayCli, QuietAfterTheSubcommand) {
 TEST_F(ReplayCli, HelpNamesTheOptions) {
   const CommandRun run = Linetrack("replay --help");
   EXPECT_EQ(run.code, 0);
-  for (const char* flag : {"--input", "--prior-file", "--init-pose", "--ground-truth",
-                           "--overlay-png", "--settings", "--kidnap-after", "--no-global"}) {
+  for (const char* flag :
+       {"--input", "--prior-file", "--init-pose", "--ground-truth", "--overlay-png", "--settings",
+        "--kidnap-after-s", "--global-after-s", "--no-global"}) {
     EXPECT_NE(run.out.find(flag), std::string::npos) << flag;
   }
 }

@@ -28,6 +28,7 @@ constexpr double kNearM = 0.10;           // integrity rules: a `tracking` pose 
 constexpr double kNearDeg = 2.0;
 constexpr double kGlobalPoseM = 0.03;  // the global mode's verified pose against the truth
 constexpr double kGlobalPoseDeg = 0.5;
+constexpr int kConfirmFrames = 5;  // ReacquisitionCheck::confirm_frames
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 
@@ -125,6 +126,10 @@ TEST(KidnappedRobot, TheGlobalModeFindsTheNewPoseAndConfirmsItWithNoWrongPose) {
   ASSERT_GE(global, kKidnapFrame) << "the global mode found no pose" << trace;
   EXPECT_NE(reports[global].uncertainty.reason.find("global mode"), std::string::npos)
       << reports[global].uncertainty.reason;
+  // The frame holds the global pose and not the pose the global mode left, carried by the
+  // odometry: the image shows the carry, and that pose is no longer a hypothesis.
+  EXPECT_NE(reports[global].uncertainty.reason.find("a carry"), std::string::npos)
+      << reports[global].uncertainty.reason;
   EXPECT_FALSE(reports[global].cam_from_world.has_value()) << "an unconfirmed global pose";
   ASSERT_GT(reported, global) << "the global pose was never reported" << trace;
   const PoseDifference found =
@@ -134,6 +139,38 @@ TEST(KidnappedRobot, TheGlobalModeFindsTheNewPoseAndConfirmsItWithNoWrongPose) {
   ASSERT_GE(tracking, global) << "the global pose was never confirmed" << trace;
   EXPECT_LE(tracking - kKidnapFrame, kMaxFramesToTracking) << trace;
   ExpectNoWrongTrackingPose(reports, d);
+}
+
+// A global pose the tracker loses before its confirmation and the matcher finds again around it
+// is still a global pose: the frames after are withheld until confirm_frames of them are tracked,
+// not reported as a re-localisation after a good pose (the global pose was never good).
+TEST(KidnappedRobot, AGlobalPoseLostBeforeItsConfirmationIsStillWithheld) {
+  const KidnapDrive& d = Drive();
+  const std::vector<FrameReport> first = Replay(d, EngineOptions());
+  int global = -1;
+  for (int i = kKidnapFrame; i < kFrames && global < 0; ++i) {
+    if (first[i].source == "global" && first[i].status == TrackStatus::kRelocalised) global = i;
+  }
+  ASSERT_GE(global, kKidnapFrame) << "the global mode found no pose";
+  const int blank = global + 2;  // a covered lens while the global pose is being confirmed
+  ASSERT_LT(blank + kConfirmFrames + 1, kFrames);
+  KidnapDrive covered = d;
+  covered.images[blank] =
+      vpImage<unsigned char>(d.images[blank].getHeight(), d.images[blank].getWidth(), 0);
+  const std::vector<FrameReport> reports = Replay(covered, EngineOptions());
+  EXPECT_FALSE(reports[blank].cam_from_world.has_value()) << reports[blank].note;
+  int found_again = -1;
+  for (int i = blank + 1; i < kFrames && found_again < 0; ++i) {
+    if (reports[i].status == TrackStatus::kRelocalised) found_again = i;
+  }
+  ASSERT_GT(found_again, blank) << "the pose was not found again after the covered frame";
+  // Found again, it is tracked over confirm_frames frames before anything is reported.
+  for (int i = found_again; i < std::min(found_again + kConfirmFrames, kFrames); ++i) {
+    EXPECT_FALSE(reports[i].cam_from_world.has_value())
+        << "frame " << i << ": " << ToString(reports[i].uncertainty.status) << ", "
+        << reports[i].source << ", " << reports[i].uncertainty.reason;
+  }
+  ExpectNoWrongTrackingPose(reports, covered);
 }
 
 // The control: without the global mode the engine searches around the carried prior and does
@@ -152,33 +189,56 @@ TEST(KidnappedRobot, WithoutTheGlobalModeTheRobotIsNotFoundAgain) {
 
 TEST(GlobalModeReason, EachTriggerAndItsThreshold) {
   GlobalRecoveryOptions o;
-  o.kidnap_frames = 3;
-  o.lost_frames = 25;
+  o.kidnap_s = 0.3;
+  o.lost_s = 2.5;
   o.lost_distance_m = 3.0;
   LossState s;
   s.has_prior = false;
   EXPECT_EQ(GlobalModeReason(s, o), "no prior");
   s.has_prior = true;
+  s.frame_period_s = 0.1;  // 10 frames/s
   s.frames_since_good = 2;
   s.failed_searches = 2;
   s.driven_since_m = 0.2;
   EXPECT_EQ(GlobalModeReason(s, o), "");
   s.failed_searches = 3;
-  EXPECT_NE(GlobalModeReason(s, o).find("carried away"), std::string::npos);
+  EXPECT_NE(GlobalModeReason(s, o).find("carried away: 3 frames"), std::string::npos);
   s.failed_searches = 0;
   s.frames_since_good = 25;
-  EXPECT_EQ(GlobalModeReason(s, o), "lost 25 frames");
+  EXPECT_EQ(GlobalModeReason(s, o), "lost 25 frames (2.5 s)");
   s.frames_since_good = 24;
   s.driven_since_m = 3.0;
   EXPECT_EQ(GlobalModeReason(s, o), "lost over 3.0 m");
   s.driven_since_m = -1.0;  // no odometry: distance says nothing
   EXPECT_EQ(GlobalModeReason(s, o), "");
-  o.lost_frames = 0;  // off
+  o.lost_s = 0.0;  // off
   s.frames_since_good = 1000;
   EXPECT_EQ(GlobalModeReason(s, o), "");
   std::string why;
-  o.kidnap_frames = -1;
+  o.kidnap_s = -1.0;
   EXPECT_FALSE(o.Check(&why));
+}
+
+// The same seconds are more frames at a higher frame rate; no trigger on time before the frames'
+// interval is known.
+TEST(GlobalModeReason, TheTimesBecomeFramesAtTheFramesRate) {
+  EXPECT_EQ(FramesIn(0.3, 0.1), 3);
+  EXPECT_EQ(FramesIn(0.3, 1.0 / 30.0), 9);
+  EXPECT_EQ(FramesIn(2.5, 0.1), 25);
+  EXPECT_EQ(FramesIn(2.5, 0.04), 63);  // 25 frames/s: 2.52 s
+  EXPECT_EQ(FramesIn(0.3, 1.0), 1);    // a slow camera: the next frame
+  EXPECT_EQ(FramesIn(0.0, 0.1), 0);    // off
+  EXPECT_EQ(FramesIn(0.3, 0.0), 0);    // interval not known
+  GlobalRecoveryOptions o;
+  LossState s;
+  s.has_prior = true;
+  s.failed_searches = 3;
+  s.frame_period_s = 1.0 / 30.0;
+  EXPECT_EQ(GlobalModeReason(s, o), "") << "3 frames at 30 frames/s are 0.1 s";
+  s.failed_searches = 9;
+  EXPECT_NE(GlobalModeReason(s, o).find("carried away"), std::string::npos);
+  s.frame_period_s = 0.0;
+  EXPECT_EQ(GlobalModeReason(s, o), "");
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "tracking/tracker/global_recovery.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "models/errors.h"
 #include "models/text_format.h"
@@ -9,8 +11,8 @@
 namespace linetrack {
 
 bool GlobalRecoveryOptions::Check(std::string* why) const {
-  if (kidnap_frames < 0 || lost_frames < 0 || kidnap_min_lines < 0) {
-    *why = "global mode: frames before the switch must be >= 0 (0: off)";
+  if (!(kidnap_s >= 0.0) || !(lost_s >= 0.0) || kidnap_min_lines < 0) {
+    *why = "global mode: the seconds before the switch and the lines must be >= 0 (0: off)";
     return false;
   }
   if (!(rival_distance_m > 0.0) || !(rival_heading_deg > 0.0)) {
@@ -24,15 +26,24 @@ bool GlobalRecoveryOptions::Check(std::string* why) const {
   return true;
 }
 
+int FramesIn(double seconds, double period_s) {
+  if (!(seconds > 0.0) || !(period_s > 0.0)) return 0;
+  // A relative tolerance so that 0.3 s at 0.1 s (0.30000000000000004 / 0.1) gives 3 frames.
+  return std::max(1, static_cast<int>(std::ceil(seconds / period_s - 1e-6)));
+}
+
 std::string GlobalModeReason(const LossState& s, const GlobalRecoveryOptions& o) {
   if (!s.has_prior) return "no prior";
   const bool odometry = s.driven_since_m >= 0.0;
-  if (o.kidnap_frames > 0 && s.failed_searches >= o.kidnap_frames) {
-    return "carried away: " + std::to_string(s.failed_searches) +
-           " frames with lines disagree with the carried prior";
+  const int kidnap_frames = FramesIn(o.kidnap_s, s.frame_period_s);
+  if (kidnap_frames > 0 && s.failed_searches >= kidnap_frames) {
+    return "carried away: " + std::to_string(s.failed_searches) + " frames with lines (" +
+           Fixed(s.failed_searches * s.frame_period_s, 1) + " s) disagree with the carried prior";
   }
-  if (o.lost_frames > 0 && s.frames_since_good >= o.lost_frames) {
-    return "lost " + std::to_string(s.frames_since_good) + " frames";
+  const int lost_frames = FramesIn(o.lost_s, s.frame_period_s);
+  if (lost_frames > 0 && s.frames_since_good >= lost_frames) {
+    return "lost " + std::to_string(s.frames_since_good) + " frames (" +
+           Fixed(s.frames_since_good * s.frame_period_s, 1) + " s)";
   }
   if (o.lost_distance_m > 0.0 && odometry && s.driven_since_m >= o.lost_distance_m) {
     return "lost over " + Fixed(s.driven_since_m, 1) + " m";

@@ -16,19 +16,21 @@
 
 namespace linetrack {
 
-// When a lost robot switches to the global mode (a trigger at 0 is off).
+// When a lost robot switches to the global mode (a trigger at 0 is off). The triggers are times
+// and distances; the engine turns the times into frame counts with the frame interval it reads
+// from the frames' stamps (FramesIn), so that they mean the same at any frame rate.
 struct GlobalRecoveryOptions {
   // The engine builds the global mode (for these triggers and SequenceTracker::RequestGlobal).
   bool enabled = true;
-  // kidnap_frames matcher searches in a row around the carried prior found no consistent
-  // hypothesis on frames with at least kidnap_min_lines segments: the view disagrees with the
-  // prior, the robot was carried away (the odometry does not see the carry, so it cannot tell).
+  // Matcher searches in a row around the carried prior found no consistent hypothesis on the
+  // frames of kidnap_s seconds that show at least kidnap_min_lines segments: the view disagrees
+  // with the prior, the robot may have been carried away (the odometry does not see a carry).
   // A blank frame leaves the count as it is; a pose found near the prior resets it.
-  int kidnap_frames = 3;
+  double kidnap_s = 0.3;
   int kidnap_min_lines = 8;
-  // Lost for lost_frames frames (the relocaliser's widening bounds reach their limit after 24
-  // frames by default) or lost_distance_m metres driven since the last good pose.
-  int lost_frames = 25;
+  // Lost for lost_s seconds (the relocaliser's widening bounds reach their limit after 24 frames
+  // of 0.1 s by default) or lost_distance_m metres driven since the last good pose.
+  double lost_s = 2.5;
   double lost_distance_m = 3.0;
   // A re-localisation by the matcher near the carried prior is checked by the global mode: an
   // ambiguous answer, or a pose farther than rival_distance_m or rival_heading_deg from the
@@ -41,12 +43,17 @@ struct GlobalRecoveryOptions {
   bool Check(std::string* why) const;
 };
 
+// The frames that cover `seconds` at one frame every `period_s` seconds (at least 1); 0 when
+// `seconds` is 0 (the trigger is off) or the period is not known yet (period_s <= 0).
+int FramesIn(double seconds, double period_s);
+
 // A lost robot's situation on one frame.
 struct LossState {
   bool has_prior = false;        // there is a prior for the matcher (a good pose, odometry, ...)
   int frames_since_good = 0;     // frames since the last good pose
   int failed_searches = 0;       // matcher searches in a row that found nothing, frames with lines
   double driven_since_m = -1.0;  // odometry distance since the last good pose; < 0: no odometry
+  double frame_period_s = 0.0;   // the frames' interval from their stamps; <= 0: not known yet
 };
 
 // Why this frame needs the global mode (pure), or empty when the local matcher keeps searching.

@@ -220,27 +220,7 @@ bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robo
   const bool odometry = robot && robot->odometry;
   const double sigma = u.has_covariance() ? 3.0 * std::max(u.sigma_x_m, u.sigma_y_m) : 0.0;
   if (started_after || !reacquisition_) {
-    Reacquisition r;
-    r.pose = pose;
-    r.robot = robot;
-    r.driven_at_start_m = driven_m_;
-    if (started_after) r.before = *started_after;
-    r.global = global_mode_;
-    const GoodPose* before = r.before ? &*r.before : nullptr;
-    if (before && odometry && before->robot && before->robot->odometry) {
-      const Eigen::Vector2d d =
-          PlanarDifference(pose, Carry(PlanarOf(before->cam_from_world), *before->robot, *robot));
-      const double driven = driven_m_ - before->driven_m;
-      const double allowance = ReacquisitionAllowanceM(check, driven) + sigma;
-      r.jump_m = d[0];
-      if (d[0] > allowance || d[1] > check.heading_allowance_rad + check.drift_share * driven) {
-        r.jump = Fixed(d[0], 2) + " m / " + Fixed(RadToDeg(d[1]), 1) +
-                 " deg from where the odometry carries the last good pose (allowance " +
-                 Fixed(allowance, 2) + " m)";
-        r.needed_m = check.confirm_distance_m;
-      }
-    }
-    reacquisition_ = r;
+    reacquisition_ = NewReacquisition(pose, robot, started_after, sigma);
   } else {
     Reacquisition& r = *reacquisition_;
     ++r.frames;
@@ -256,29 +236,73 @@ bool SequenceTracker::CheckReacquisition(const std::optional<RobotReading>& robo
     }
   }
   const Reacquisition& r = *reacquisition_;
-  const double driven = driven_m_ - r.driven_at_start_m;
+  const double driven = driven_m_ - r.episode_start_m;
   if (r.frames >= check.confirm_frames && driven >= r.needed_m) {
     reacquisition_.reset();
     global_reason_.clear();  // a confirmed pose: the global mode's drop is over
+    global_before_.reset();
     return true;
   }
   std::string why = "re-localisation being confirmed: " + std::to_string(r.frames) + " of " +
                     std::to_string(check.confirm_frames) + " frames";
   if (!r.jump.empty()) {
     why += ", " + Fixed(driven, 1) + " of " + Fixed(r.needed_m, 1) + " m; " + r.jump;
-    // Either the matcher's pose or the one the odometry carries may be right: the covariance
-    // spans both.
+    // Either the re-localised pose or the one the odometry carries may be right: the covariance
+    // and the protection levels span both.
     if (u.has_covariance()) {
       u.world_covariance(0, 0) += r.jump_m * r.jump_m;
       u.world_covariance(1, 1) += r.jump_m * r.jump_m;
+      u.world_covariance(5, 5) += r.jump_rad * r.jump_rad;
       u.sigma_x_m = std::sqrt(u.world_covariance(0, 0));
       u.sigma_y_m = std::sqrt(u.world_covariance(1, 1));
+      u.sigma_heading_rad = std::sqrt(u.world_covariance(5, 5));
       u.protection_position_m += r.jump_m;
+      u.protection_rotation_rad += r.jump_rad;
     }
   }
   if (u.status == IntegrityStatus::kTracking) u.status = IntegrityStatus::kDegraded;
   u.reason = u.reason.empty() ? why : why + "; " + u.reason;
   return true;
+}
+
+SequenceTracker::Reacquisition SequenceTracker::NewReacquisition(
+    const Pose3Dof& pose, const std::optional<RobotReading>& robot,
+    const std::optional<GoodPose>* started_after, double sigma) const {
+  const ReacquisitionCheck& check = options_.reacquisition;
+  Reacquisition r;
+  r.pose = pose;
+  r.robot = robot;
+  r.driven_at_start_m = r.episode_start_m = driven_m_;
+  if (started_after) r.before = *started_after;
+  r.global = global_mode_;
+  if (r.global) r.before.reset();
+  // A re-localisation while a global one is unconfirmed (the tracker lost it, the matcher found
+  // it again around it) continues that one: nothing else before it bounds it either.
+  if (reacquisition_ && reacquisition_->global) {
+    r.global = true;
+    r.before.reset();
+    r.reference = reacquisition_->reference;
+    r.episode_start_m = reacquisition_->episode_start_m;
+  } else {
+    r.reference = r.global ? global_before_ : r.before;
+  }
+  const GoodPose* reference = r.reference ? &*r.reference : nullptr;
+  if (reference && robot && robot->odometry && reference->robot && reference->robot->odometry) {
+    const Eigen::Vector2d d = PlanarDifference(
+        pose, Carry(PlanarOf(reference->cam_from_world), *reference->robot, *robot));
+    const double driven = driven_m_ - reference->driven_m;
+    const double allowance = ReacquisitionAllowanceM(check, driven) + sigma;
+    if (d[0] > allowance || d[1] > check.heading_allowance_rad + check.drift_share * driven) {
+      r.jump_m = d[0];
+      r.jump_rad = d[1];
+      r.jump = Fixed(d[0], 2) + " m / " + Fixed(RadToDeg(d[1]), 1) +
+               " deg from where the odometry carries " +
+               (r.global ? "the pose the global mode left" : "the last good pose") +
+               " (allowance " + Fixed(allowance, 2) + " m)";
+      r.needed_m = check.confirm_distance_m;
+    }
+  }
+  return r;
 }
 
 void SequenceTracker::Drop(const std::string& why, FrameReport* report) {
@@ -378,6 +402,7 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
   if (start_pose_ && StartAndVerify(*start_pose_, t, robot, report)) {
     start_pose_.reset();
     global_mode_ = false;
+    global_before_.reset();
     return "start pose";
   }
   if (global_ && robot) {
@@ -436,6 +461,11 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
                                      const std::optional<RobotReading>& robot) {
   const Clock::time_point start = Clock::now();
   ++frame_index_;
+  if (frame_index_ > 0 && t > t_) {
+    recent_intervals_.push_back(t - t_);
+    if (recent_intervals_.size() > 15) recent_intervals_.pop_front();
+  }
+  t_ = t;
   if (robot && robot->odometry) {
     if (last_odometry_) {
       driven_m_ += std::hypot(robot->odometry->x - last_odometry_->x,

@@ -199,8 +199,19 @@ class SequenceTracker {
   // (GlobalRecoveryOptions::check_relocalisations): true (and the global mode entered) when it
   // has a rival elsewhere or is ambiguous.
   bool HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot, FrameReport* report);
-  // Localises the frame with the global mode and verifies its pose; false when none.
+  // Localises the frame with the global mode and verifies its pose; false when none. A pose away
+  // from the one the global mode left is checked against the image (HypothesisHolds).
   bool TryGlobal(double t, const RobotReading& robot, FrameReport* report);
+  // Where the odometry carries the pose the global mode left (global_before_) to `robot`'s
+  // reading; none without it or without odometry at both readings.
+  std::optional<Eigen::Isometry3d> CarriedGlobalBefore(const RobotReading& robot) const;
+  // True when this frame holds `hypothesis` (the pose the global mode left, carried): the tracker
+  // verifies it, or the matcher finds a pose around it within the reacquisition allowance after
+  // `driven_m` metres. Changes the tracker's state: the caller restarts it.
+  bool HypothesisHolds(const Eigen::Isometry3d& hypothesis, double driven_m, double t,
+                       const RobotReading& robot);
+  // The frames' interval (seconds): the median of the last stamps' differences; 0 before two.
+  double FramePeriod() const;
   // With odometry now and at the last frame: restarts the tracker from the predicted pose when
   // the predicted image motion is large.
   void MaybePredict(const std::optional<RobotReading>& robot, FrameReport* report);
@@ -216,6 +227,11 @@ class SequenceTracker {
   // reacquisition check; false when the tracked motion departs from the odometry's.
   bool CheckReacquisition(const std::optional<RobotReading>& robot,
                           const std::optional<GoodPose>* started_after, FrameReport* report);
+  struct Reacquisition;
+  // The check of a re-localised `pose` starting on this frame: its reference and the jump from
+  // where the odometry carries it (beyond the allowance plus `sigma` metres).
+  Reacquisition NewReacquisition(const Pose3Dof& pose, const std::optional<RobotReading>& robot,
+                                 const std::optional<GoodPose>* started_after, double sigma) const;
   void Drop(const std::string& why, FrameReport* report);
   // The last reported pose carried to this frame by the odometry (none without an anchor or
   // odometry).
@@ -241,6 +257,11 @@ class SequenceTracker {
     std::string jump;       // that disagreement in words, when beyond the allowance
     std::optional<GoodPose> before;
     bool global = false;  // found by the global mode (no pose before it to compare)
+    // The pose the re-localisation is compared with: the good pose before it, or for a global
+    // pose the one the global mode left while the image has not refuted it.
+    std::optional<GoodPose> reference;
+    double jump_rad = 0.0;         // heading difference from the reference carried
+    double episode_start_m = 0.0;  // odometry distance at the first re-localisation of the episode
   };
 
   EdgeTracker* tracker_;
@@ -254,6 +275,11 @@ class SequenceTracker {
   std::optional<Eigen::Isometry3d> start_pose_;
   std::optional<Pose3Dof> initial_prior_;
   std::optional<GoodPose> last_good_;
+  // The pose the global mode left (the last good pose, or the matcher's pose the rival check
+  // withheld): until the image refutes it (a carry) or a pose is confirmed, where the odometry
+  // carries it may be the truth, and a global answer away from it carries the jump in its
+  // covariance until confirmed by driving (ReacquisitionCheck::confirm_distance_m).
+  std::optional<GoodPose> global_before_;
   std::optional<Reacquisition> reacquisition_;
   std::optional<Pose3Dof> last_odometry_;
   std::optional<CoastAnchor> anchor_;  // the last reported pose with finite levels
@@ -269,6 +295,8 @@ class SequenceTracker {
   int failed_searches_ = 0;    // matcher searches in a row finding nothing (GlobalRecoveryOptions)
   std::string global_reason_;  // why the global mode was entered
   long frame_index_ = -1;      // frames processed - 1
+  double t_ = 0.0;             // this frame's stamp (seconds)
+  std::deque<double> recent_intervals_;  // the last stamps' differences (seconds)
   long last_good_index_ = -1;
   int losses_ = 0;
   int recoveries_ = 0;

@@ -1,15 +1,32 @@
 // The tracking engine's recovery paths (sequence_tracker.h): the global mode of a lost or
 // carried robot, and coasting on the odometry through frames without an image pose.
+#include <algorithm>
 #include <string>
 
+#include "models/statistics.h"
 #include "models/text_format.h"
 #include "tracking/tracker/planar_readings.h"
 #include "tracking/tracker/sequence_tracker.h"
 
 namespace linetrack {
+namespace {
+
+// The matcher's bounds around the pose the global mode left, carried `driven_m` metres by the
+// odometry: the reacquisition allowance, at least the bounds just after a loss.
+SearchBounds HypothesisBounds(const RelocalizationOptions& relocalization,
+                              const ReacquisitionCheck& check, double driven_m) {
+  const SearchBounds& after_loss = relocalization.after_loss;
+  return {
+      std::max(after_loss.delta_t, ReacquisitionAllowanceM(check, driven_m)),
+      std::max(after_loss.delta_phi, check.heading_allowance_rad + check.drift_share * driven_m)};
+}
+
+}  // namespace
 
 void SequenceTracker::EnterGlobalMode(const std::string& why) {
   following_ = false;
+  // An unconfirmed global pose is no hypothesis: the one its confirmation is held against stays.
+  if (last_good_ && !(reacquisition_ && reacquisition_->global)) global_before_ = last_good_;
   last_good_.reset();
   reacquisition_.reset();
   recent_projection_errors_.clear();
@@ -24,6 +41,7 @@ void SequenceTracker::RequestGlobal() {
   start_pose_.reset();
   initial_prior_.reset();
   EnterGlobalMode("asked");
+  global_before_.reset();  // every prior is dropped
 }
 
 bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot,
@@ -42,10 +60,15 @@ bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading
     }
   }
   if (rival.empty()) return false;
+  // The matcher's pose, verified on this frame, is a hypothesis the global mode must refute
+  // (unless it was found around an unconfirmed global pose: that one's reference stays).
+  const GoodPose matcher{pose, t_, robot, driven_m_};
+  const bool keep = reacquisition_ && reacquisition_->global;
   EnterGlobalMode("the matcher's pose near the prior has a rival: " + rival);
   report->cam_from_world.reset();
   report->source = "global";
   report->note = "global mode (" + global_reason_ + ")";
+  if (!keep) global_before_ = matcher;
   return true;
 }
 
@@ -57,6 +80,7 @@ void SequenceTracker::MaybeSwitchToGlobal(const RobotReading& robot) {
   state.has_prior = relocalizer_ && MatcherPrior(robot, &prior, &bounds);
   state.frames_since_good = last_good_ ? FramesSinceGood() : static_cast<int>(frame_index_ + 1);
   state.failed_searches = failed_searches_;
+  state.frame_period_s = FramePeriod();
   if (robot.odometry) state.driven_since_m = driven_m_ - (last_good_ ? last_good_->driven_m : 0.0);
   const std::string why = GlobalModeReason(state, options_.global);
   if (why.empty()) return;
@@ -71,8 +95,44 @@ bool SequenceTracker::TryGlobal(double t, const RobotReading& robot, FrameReport
   const std::string mode = "global mode (" + global_reason_ + "): ";
   if (!attempt.found) {
     report->note = mode + attempt.reason;
+    // With no rival on the frame (the global mode found no pose elsewhere, and the view is not
+    // ambiguous), the matcher searches around the pose the mode left, as it would have without
+    // the switch: a trigger with no carry (a blurred stretch) then costs no more frames. Its pose
+    // is confirmed like a global one, against that pose.
+    const std::optional<Eigen::Isometry3d> before = CarriedGlobalBefore(robot);
+    if (attempt.ambiguous || !before || !relocalizer_) return false;
+    const double driven = driven_m_ - global_before_->driven_m;
+    const RelocalizationAttempt around = relocalizer_->Attempt(
+        *undistorted_, WithReading(PlanarOf(*before), robot),
+        HypothesisBounds(relocalizer_->options(), options_.reacquisition, driven));
+    if (!around.found) return false;
+    if (!StartAndVerify(around.cam_from_world, t, robot, report)) {
+      report->note = mode + attempt.reason + "; around the pose it left: " + report->note;
+      return false;
+    }
+    return true;
+  }
+  if (!StartAndVerify(attempt.cam_from_world, t, robot, report)) {
+    report->note = mode + "its pose is not confirmed by the edges: " + report->note;
     return false;
   }
+  // Away from the pose the global mode left, the answer is either a carry or a view that repeats
+  // elsewhere. A frame that holds the answer but not the pose left (carried by the odometry)
+  // shows a carry: that pose is no longer a hypothesis. Otherwise both stay (NewReacquisition).
+  const std::optional<Eigen::Isometry3d> before = CarriedGlobalBefore(robot);
+  if (!before) return true;
+  const ReacquisitionCheck& check = options_.reacquisition;
+  const double driven = driven_m_ - global_before_->driven_m;
+  const Eigen::Vector2d d = PlanarDifference(PlanarOf(attempt.cam_from_world), PlanarOf(*before));
+  if (d[0] <= ReacquisitionAllowanceM(check, driven) &&
+      d[1] <= check.heading_allowance_rad + check.drift_share * driven) {
+    return true;
+  }
+  if (!HypothesisHolds(*before, driven, t, robot)) {
+    global_before_.reset();
+    global_reason_ += "; a carry: the frame holds its pose, not the one the mode left";
+  }
+  // The tracker back on the global pose (the same frame and start: the same result).
   if (!StartAndVerify(attempt.cam_from_world, t, robot, report)) {
     report->note = mode + "its pose is not confirmed by the edges: " + report->note;
     return false;
@@ -80,12 +140,44 @@ bool SequenceTracker::TryGlobal(double t, const RobotReading& robot, FrameReport
   return true;
 }
 
+std::optional<Eigen::Isometry3d> SequenceTracker::CarriedGlobalBefore(
+    const RobotReading& robot) const {
+  if (!global_before_ || !global_before_->robot || !global_before_->robot->odometry ||
+      !robot.odometry) {
+    return std::nullopt;
+  }
+  const RobotReading& then = *global_before_->robot;
+  return PredictFromOdometry(global_before_->cam_from_world, WithReading(*then.odometry, then),
+                             WithReading(*robot.odometry, robot));
+}
+
+bool SequenceTracker::HypothesisHolds(const Eigen::Isometry3d& hypothesis, double driven_m,
+                                      double t, const RobotReading& robot) {
+  FrameReport scratch;
+  if (StartAndVerify(hypothesis, t, robot, &scratch)) return true;
+  if (!relocalizer_) return false;
+  return relocalizer_
+      ->Attempt(*undistorted_, WithReading(PlanarOf(hypothesis), robot),
+                HypothesisBounds(relocalizer_->options(), options_.reacquisition, driven_m))
+      .found;
+}
+
+double SequenceTracker::FramePeriod() const {
+  if (recent_intervals_.empty()) return 0.0;
+  return QuantileNearestRank(recent_intervals_, 0.5);
+}
+
 void SequenceTracker::WithholdUnconfirmedGlobal(FrameReport* report) const {
   // Also a matcher's pose after the global mode dropped the last good pose: nothing before it
   // bounds a wrong answer either (global_reason_ is kept until a pose is confirmed).
+  // Past its confirm_frames a pose is reported: confirmed, or with the jump from the pose the
+  // global mode left in its covariance (NewReacquisition).
   const bool unanchored = reacquisition_ && (reacquisition_->global ||
                                              (!global_reason_.empty() && !reacquisition_->before));
-  if (!unanchored || !report->cam_from_world) return;
+  if (!unanchored || !report->cam_from_world ||
+      reacquisition_->frames >= options_.reacquisition.confirm_frames) {
+    return;
+  }
   report->cam_from_world.reset();
   PoseUncertainty& u = report->uncertainty;
   const std::string was = u.reason;
