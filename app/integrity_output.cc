@@ -92,6 +92,8 @@ IntegrityOptions IntegrityFlags::Options(const IntegrityOptions& base) const {
   }
   CheckRange(edge_fault_prior, 0.0, 0.5, "--edge-fault-prior");
   options.edge_fault_probability = edge_fault_prior;
+  CheckRange(exclusion_risk, 1e-12, 0.25, "--exclusion-risk");
+  options.exclusion_risk = exclusion_risk;
   std::string why;
   if (!options.Check(&why)) throw InputError("--alert-limit/--camera-sigma: " + why);
   return options;
@@ -116,6 +118,11 @@ void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags) {
   cmd->add_option("--edge-fault-prior", flags->edge_fault_prior,
                   "Prior probability that one edge's points are wrong beyond the noise (latched "
                   "on an unmodelled line): the protection levels cover such a fault")
+      ->capture_default_str();
+  cmd->add_option("--exclusion-risk", flags->exclusion_risk,
+                  "After the fault test excludes an edge: the probability, beside the integrity "
+                  "risk, that a wrong exclusion leaves the error beyond the protection levels "
+                  "(docs/integrity.md 2.3); the total risk stays within integrity + 2 x this")
       ->capture_default_str();
   cmd->add_option("--held-parameters", flags->held_parameters,
                   "What the pose solve does with the intrinsics and the camera's height, tilt "

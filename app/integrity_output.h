@@ -23,6 +23,8 @@ struct IntegrityFlags {
   double model_sigma_m = EdgeNoiseOptions().model_sigma_m;
   double casing_sigma_m = EdgeNoiseOptions().casing_sigma_m;
   double edge_fault_prior = IntegrityOptions().edge_fault_probability;
+  // Risk of a wrong fault exclusion that the levels after an exclusion may leave uncovered.
+  double exclusion_risk = IntegrityOptions().exclusion_risk;
   // What the solve does with the intrinsics and the mount's height, tilt and roll: "estimate"
   // or "consider" for both, or "INTRINSICS,MOUNT" (e.g. "consider,estimate"); empty: the default.
   std::string held_parameters;
@@ -32,8 +34,8 @@ struct IntegrityFlags {
   IntegrityOptions Options(const IntegrityOptions& base = IntegrityOptions()) const;
 };
 
-// Adds --alert-limit, --camera-sigma, --model-sigma, --casing-sigma, --edge-fault-prior and
-// --held-parameters to `cmd`; AddAllPosesFlag --all-poses.
+// Adds --alert-limit, --camera-sigma, --model-sigma, --casing-sigma, --edge-fault-prior,
+// --exclusion-risk and --held-parameters to `cmd`; AddAllPosesFlag --all-poses.
 void AddIntegrityFlags(CLI::App* cmd, IntegrityFlags* flags);
 void AddAllPosesFlag(CLI::App* cmd, IntegrityFlags* flags);
 
