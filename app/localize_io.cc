@@ -3,58 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "app/cli_common.h"
 #include "app/model_loading.h"
 #include "models/errors.h"
 
 namespace linetrack::app {
-namespace {
-
-bool ParseNumber(const std::string& text, double* value) {
-  try {
-    size_t used = 0;
-    const std::string trimmed = text.substr(text.find_first_not_of(" \t"));
-    *value = std::stod(trimmed, &used);
-    return trimmed.find_first_not_of(" \t\r", used) == std::string::npos && std::isfinite(*value);
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-}  // namespace
-
-std::vector<Segment2> ReadLinesCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(Located(path, 0, "cannot read the lines file"));
-  std::vector<Segment2> lines;
-  std::string row;
-  int number = 0;
-  while (std::getline(in, row)) {
-    ++number;
-    if (!row.empty() && row.back() == '\r') row.pop_back();
-    if (row.find_first_not_of(" \t") == std::string::npos || row[0] == '#') continue;
-    std::stringstream fields(row);
-    std::string field;
-    double v[4];
-    int n = 0;
-    bool numeric = true;
-    while (std::getline(fields, field, ',')) {
-      if (n < 4) numeric = numeric && ParseNumber(field, &v[n]);
-      ++n;
-    }
-    if (!numeric && lines.empty() && number == 1) continue;  // header row
-    if (n != 4 || !numeric) {
-      throw InputError(Located(path, number, "expected 4 finite numbers u1,v1,u2,v2"));
-    }
-    lines.push_back({{v[0], v[1]}, {v[2], v[3]}});
-  }
-  if (lines.empty()) throw InputError(Located(path, 0, "no line segments"));
-  return lines;
-}
 
 double CameraZ(const WireframeModel& model, double height, int storey, double floor_z) {
   if (std::isfinite(floor_z)) return floor_z + height;

@@ -1,5 +1,5 @@
-// Files of `linetrack localize`: the line CSV, the batch cases (JSON lines) and the result
-// JSON, plus a cache that loads each model and camera once.
+// Files of `linetrack localize`: the batch cases (JSON lines) and the result JSON, plus a cache
+// that loads each model and camera once (the line CSV: app/lines_csv.h).
 #pragma once
 
 #include <limits>
@@ -16,9 +16,6 @@
 #include "models/view_invariant_regions.h"
 
 namespace linetrack::app {
-
-// Reads `u1,v1,u2,v2` rows (pixels, header row optional). Throws InputError "file:line: what".
-std::vector<Segment2> ReadLinesCsv(const std::string& path);
 
 // One case of a batch file (see docs/matching.md for the format).
 struct BatchCase {

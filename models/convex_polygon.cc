@@ -197,6 +197,39 @@ bool SplitConvex(const Ring2& convex, const Line2& line, double min_area, Ring2*
   return true;
 }
 
+void ConvexHull(Ring2* points, Ring2* hull) {
+  std::sort(points->begin(), points->end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+  });
+  Ring2& h = *hull;
+  h.resize(2 * points->size());
+  size_t k = 0;
+  for (size_t pass = 0; pass < 2; ++pass) {
+    const size_t start = k;
+    for (const Eigen::Vector2d& p : *points) {
+      while (k >= start + 2 && Cross2(h[k - 1] - h[k - 2], p - h[k - 2]) <= 0.0)
+        --k;
+      h[k++] = p;
+    }
+    --k;  // the last point starts the other chain
+    std::reverse(points->begin(), points->end());
+  }
+  h.resize(std::max<size_t>(k, 1));
+}
+
+Ring2 ClipConvex(const Ring2& convex, const Line2& line) {
+  Ring2 out;
+  const size_t n = convex.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d &p = convex[i], &q = convex[(i + 1) % n];
+    const double sp = line.SignedDistance(p), sq = line.SignedDistance(q);
+    if (sp >= 0.0) out.push_back(p);
+    if ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0))
+      out.push_back(p + sp / (sp - sq) * (q - p));
+  }
+  return out;
+}
+
 bool ClipSegmentToConvex(const Ring2& convex, const Segment2& s, double* t0, double* t1) {
   double lo = 0.0, hi = 1.0;
   const Eigen::Vector2d d = s.b - s.a;

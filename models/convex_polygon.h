@@ -54,6 +54,14 @@ bool SplitConvex(const Ring2& convex, const Line2& line, double min_area, Ring2*
 // the segment misses it.
 bool ClipSegmentToConvex(const Ring2& convex, const Segment2& s, double* t0, double* t1);
 
+// Counter-clockwise convex hull of `points` (Andrew's monotone chain; sorts them) into `hull`,
+// whose storage is reused. Collinear points are left out; one point for coincident points.
+void ConvexHull(Ring2* points, Ring2* hull);
+
+// The part of the convex ring on the positive side of `line` (SignedDistance >= 0); empty when
+// none of it is.
+Ring2 ClipConvex(const Ring2& convex, const Line2& line);
+
 // True when the ring is convex (every turn left, collinear vertices allowed within `tolerance`).
 bool IsConvexRing(const Ring2& ring, double tolerance = 1e-12);
 

@@ -211,6 +211,48 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
   return true;
 }
 
+std::vector<std::vector<WallCorner>> WallCorners(const std::vector<Segment2>& walls,
+                                                 double tolerance) {
+  std::vector<std::vector<WallCorner>> corners(walls.size());
+  for (size_t i = 0; i < walls.size(); ++i) {
+    for (size_t j = i + 1; j < walls.size(); ++j) {
+      const Eigen::Vector2d u = walls[i].b - walls[i].a, v = walls[j].b - walls[j].a;
+      if (std::abs(Cross2(u.normalized(), v.normalized())) < 1e-9) continue;  // collinear
+      const Segment2 ends_i[2] = {walls[i], {walls[i].b, walls[i].a}};
+      const Segment2 ends_j[2] = {walls[j], {walls[j].b, walls[j].a}};
+      for (const Segment2& e : ends_i) {  // e.a the end that may meet, e.b the far one
+        for (const Segment2& f : ends_j) {
+          if ((e.a - f.a).norm() > tolerance) continue;
+          corners[i].push_back({e.a, e.b, f.b});
+          corners[j].push_back({f.a, f.b, e.b});
+        }
+      }
+    }
+  }
+  return corners;
+}
+
+bool HiddenByCorner(const Ring2& region, const Ring2& footprint, const Eigen::Vector2d& corner,
+                    const Eigen::Vector2d& far_a, const Eigen::Vector2d& far_b, double margin) {
+  // Continued past the corner far beyond any sight line: a chord on a continuation lies on the
+  // other wall's far side, and its sight line met the other wall before (docs/models.md).
+  constexpr double kBeyond = 1e4;  // metres
+  const Line2 line_a = Line2::Through(far_a, corner), line_b = Line2::Through(far_b, corner);
+  // The footprint's side of each line; the other wall's far end must lie on the region's side.
+  double f_a = 0.0, f_b = 0.0;
+  for (const Eigen::Vector2d& f : footprint) {
+    f_a += line_a.SignedDistance(f);
+    f_b += line_b.SignedDistance(f);
+  }
+  if (!(f_a * line_a.SignedDistance(far_b) < 0.0 && f_b * line_b.SignedDistance(far_a) < 0.0)) {
+    return false;
+  }
+  const Segment2 wall_a{far_a, corner + kBeyond * (corner - far_a).normalized()};
+  const Segment2 wall_b{far_b, corner + kBeyond * (corner - far_b).normalized()};
+  return HiddenByWall(region, footprint, wall_a, line_a, margin) &&
+         HiddenByWall(region, footprint, wall_b, line_b, margin);
+}
+
 bool HiddenBySolid(const Ring2& region, const Ring2& footprint, const Ring2& solid, double margin) {
   return HiddenBySolid(region, RingCentroid(region), footprint, solid, margin);
 }

@@ -49,6 +49,26 @@ bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& w
 bool HiddenByWall(const Ring2& region, const Ring2& footprint, const Segment2& wall,
                   const Line2& line, double margin);
 
+// Where one wall meets another at an end: the corner and the far ends of this wall and of the
+// other.
+struct WallCorner {
+  Eigen::Vector2d corner = Eigen::Vector2d::Zero();
+  Eigen::Vector2d far_self = Eigen::Vector2d::Zero(), far_other = Eigen::Vector2d::Zero();
+};
+// Per wall of `walls`, the corners it makes with the others: ends within `tolerance` metres, the
+// walls not collinear.
+std::vector<std::vector<WallCorner>> WallCorners(const std::vector<Segment2>& walls,
+                                                 double tolerance);
+
+// True when two walls meeting at `corner`, one from `far_a` and one from `far_b`, block together
+// every sight line from the region to the footprint: the corner convex seen from the region
+// (each wall's far end on the region's side of the other's line), the footprint at least `margin`
+// metres beyond both lines, and both chords of conv(region + footprint) on the walls or on their
+// continuations past the corner. Then a sight line meets one wall or the other, where neither
+// alone hides the footprint (a room's corner, seen past from inside).
+bool HiddenByCorner(const Ring2& region, const Ring2& footprint, const Eigen::Vector2d& corner,
+                    const Eigen::Vector2d& far_a, const Eigen::Vector2d& far_b, double margin);
+
 // True when every sight line from the region to the footprint passes through the interior of the
 // convex `solid` (a closed loop of occluding walls), robustly: for every direction n,
 // max over the region or over the footprint of n.x stays `margin` metres below max over the

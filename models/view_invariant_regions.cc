@@ -290,6 +290,7 @@ void ViewInvariantRegions::BuildStorey(const WireframeModel& model, const Naviga
   StoreyWalls& own = storey_walls_[s];
   own.grid = occluders.walls;
   own.lines = occluders.wall_lines;
+  own.corners = WallCorners(own.grid.segments(), kPlanTolerance);
   own.hideable.assign(model.edges().size(), 0);
   for (size_t k = 0; k < edges.ids.size(); ++k)
     own.hideable[edges.ids[k]] = edges.in_band[k];

@@ -12,6 +12,7 @@
 #include "models/camera.h"
 #include "models/convex_polygon.h"
 #include "models/navigable_area.h"
+#include "models/plan_visibility.h"
 #include "models/segment_grid.h"
 #include "models/wireframe.h"
 
@@ -123,15 +124,21 @@ class ViewInvariantRegions {
   void BuildStorey(const WireframeModel& model, const NavigableArea& area, int s,
                    const ViewInvariantRegionsOptions& options);
 
-  // True when, seen from anywhere in the query's disk, the storey's walls hide every point of the
-  // edge's footprint under the query's bearings (half: the bearings' half-width, radians).
-  bool HiddenFromDisk(const VisibilityQuery& query, double half, int storey, int edge_id) const;
+  // The convex hull of the parts of the regions `met` (indices, of the camera's storey) inside
+  // the query's disk (its circumscribed octagon): it holds every position of the query.
+  Ring2 EyesInDisk(const VisibilityQuery& query, const std::vector<int>& met) const;
+  // True when, seen from anywhere in `eyes` (EyesInDisk), the storey's walls hide every point of
+  // the edge's footprint under the query's bearings (half: the bearings' half-width, radians).
+  bool HiddenFromDisk(const VisibilityQuery& query, double half, int storey, int edge_id,
+                      const Ring2& eyes) const;
 
-  // Per storey, its occluding walls (with their lines) and per model edge whether they can hide
-  // it (an edge within the storey's band of camera heights).
+  // Per storey, its occluding walls (with their lines and, per wall, the corners it makes with
+  // others) and per model edge whether they can hide it (an edge within the storey's band of
+  // camera heights).
   struct StoreyWalls {
     SegmentGrid grid = SegmentGrid({});
     std::vector<Line2> lines;
+    std::vector<std::vector<WallCorner>> corners;
     std::vector<char> hideable;
   };
 

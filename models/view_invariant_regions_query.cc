@@ -122,12 +122,20 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
   // The query's bearings [heading - half, heading + half] as an arc of diamond angles.
   const double query_min = BearingToDiamond(query.heading - half);
   const double query_width = WrapDiamond(BearingToDiamond(query.heading + half) - query_min);
-  // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
-  std::vector<char> state(num_edges_, 0);
+  // The regions of the camera's storey that meet the disk: their union covers every position of
+  // the query.
+  std::vector<int> met;
   for (int r : candidates) {
     const ViewRegion& region = regions_[r];
     if (storey >= 0 && region.storey != storey) continue;
     if (DistanceToConvex(region.polygon.vertices, query.centre) > query.radius + 1e-9) continue;
+    met.push_back(r);
+  }
+  Ring2 eyes;  // the hull of the positions, made when an edge first needs it
+  // Per edge: 0 undecided, 1 kept, 2 dropped (its bearings from the disk miss the interval).
+  std::vector<char> state(num_edges_, 0);
+  for (int r : met) {
+    const ViewRegion& region = regions_[r];
     for (const RegionEdge& e : region.visible) {
       if (state[e.edge_id] != 0) continue;
       if (any_bearing) {
@@ -142,7 +150,8 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
       const bool narrow =
           DiskBearings(footprints_[e.edge_id], query.centre, query.radius, &arc_centre, &arc_half);
       const bool seen = !narrow || ArcsMeet(arc_centre, arc_half, query.heading, half);
-      state[e.edge_id] = seen && !HiddenFromDisk(query, half, storey, e.edge_id) ? 1 : 2;
+      if (seen && eyes.empty()) eyes = EyesInDisk(query, met);
+      state[e.edge_id] = seen && !HiddenFromDisk(query, half, storey, e.edge_id, eyes) ? 1 : 2;
     }
   }
   for (int id = 0; id < num_edges_; ++id) {
@@ -151,9 +160,26 @@ std::vector<int> ViewInvariantRegions::Query(const VisibilityQuery& query) const
   return ids;
 }
 
+Ring2 ViewInvariantRegions::EyesInDisk(const VisibilityQuery& query,
+                                       const std::vector<int>& met) const {
+  const Ring2 disk = PolygonAroundDisk(query.centre, query.radius, 8);
+  Ring2 points;
+  for (int r : met) {
+    Ring2 piece = regions_[r].polygon.vertices;
+    for (size_t k = 0; k < disk.size() && !piece.empty(); ++k)
+      piece = ClipConvex(piece, Line2::Through(disk[k], disk[(k + 1) % disk.size()]));
+    points.insert(points.end(), piece.begin(), piece.end());
+  }
+  Ring2 hull;
+  if (points.size() >= 3) ConvexHull(&points, &hull);
+  // A hull of no area (a disk that grazes its regions) is replaced by the disk's polygon.
+  return hull.size() >= 3 ? hull : disk;
+}
+
 bool ViewInvariantRegions::HiddenFromDisk(const VisibilityQuery& query, double half, int storey,
-                                          int edge_id) const {
-  // A piece of the footprint this short is not split further (metres); at most 2^kMaxDepth pieces.
+                                          int edge_id, const Ring2& eyes) const {
+  // A piece of the footprint this short, or of the eyes this small, is not split further
+  // (metres); at most 2^kMaxDepth pieces of each.
   constexpr double kMinPiece = 0.05;
   constexpr int kMaxDepth = 3;
   if (storey < 0 || storey >= static_cast<int>(storey_walls_.size())) return false;
@@ -164,21 +190,44 @@ bool ViewInvariantRegions::HiddenFromDisk(const VisibilityQuery& query, double h
                           &part)) {
     return true;  // no point of the edge under the query's bearings
   }
-  const Ring2 disk = PolygonAroundDisk(query.centre, query.radius, 8);
-  // A piece is hidden when one wall hides it from the whole disk (such a wall crosses the sight
-  // line to its middle); the edge when every piece is, the pieces halved where one is not.
-  const auto hidden = [&](const Segment2& piece, int depth, const auto& self) -> bool {
+  // A piece is hidden from a piece of the eyes when one wall hides it from all of them (such a
+  // wall crosses the sight line between their middles); the edge when every pair is, the larger
+  // of the two halved where one wall does not: two walls meeting at a corner hide together what
+  // neither hides alone.
+  const auto hidden = [&](const Segment2& piece, const Ring2& from, int piece_depth, int from_depth,
+                          const auto& self) -> bool {
     const Ring2 footprint = piece.Length() > 0.0 ? Ring2{piece.a, piece.b} : Ring2{piece.a};
-    const bool by_wall = walls.grid.AlongEveryCell(query.centre, piece.Mid(), [&](int i) {
-      return HiddenByWall(disk, footprint, walls.grid.segments()[i], walls.lines[i],
-                          hidden_margin_);
+    Eigen::Vector2d lo = from.front(), hi = lo, mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : from) {
+      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p), mean += p;
+    }
+    mean /= static_cast<double>(from.size());
+    const bool by_wall = walls.grid.AlongEveryCell(mean, piece.Mid(), [&](int i) {
+      if (HiddenByWall(from, footprint, walls.grid.segments()[i], walls.lines[i], hidden_margin_)) {
+        return true;
+      }
+      return std::any_of(walls.corners[i].begin(), walls.corners[i].end(),
+                         [&](const WallCorner& c) {
+                           return HiddenByCorner(from, footprint, c.corner, c.far_self, c.far_other,
+                                                 hidden_margin_);
+                         });
     });
     if (by_wall) return true;
-    if (depth >= kMaxDepth || piece.Length() < 2.0 * kMinPiece) return false;
-    return self({piece.a, piece.Mid()}, depth + 1, self) &&
-           self({piece.Mid(), piece.b}, depth + 1, self);
+    const Eigen::Vector2d size = hi - lo;
+    const bool split_piece = piece_depth < kMaxDepth && piece.Length() >= 2.0 * kMinPiece;
+    const bool split_from = from_depth < kMaxDepth && size.maxCoeff() >= 2.0 * kMinPiece;
+    if (split_piece && (!split_from || piece.Length() >= size.maxCoeff())) {
+      return self({piece.a, piece.Mid()}, from, piece_depth + 1, from_depth, self) &&
+             self({piece.Mid(), piece.b}, from, piece_depth + 1, from_depth, self);
+    }
+    Ring2 a, b;
+    const Eigen::Vector2d axis =
+        size.x() >= size.y() ? Eigen::Vector2d::UnitX() : Eigen::Vector2d::UnitY();
+    if (!split_from || !SplitConvex(from, {axis, axis.dot(mean)}, 0.0, &a, &b)) return false;
+    return self(piece, a, piece_depth, from_depth + 1, self) &&
+           self(piece, b, piece_depth, from_depth + 1, self);
   };
-  return hidden(part, 0, hidden);
+  return hidden(part, eyes, 0, 0, hidden);
 }
 
 std::string ViewInvariantRegions::ExplainEmptyQuery(const VisibilityQuery& query) const {

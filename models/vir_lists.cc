@@ -134,28 +134,6 @@ bool MaybeBehindItsFaces(const ModelEdge& edge, const Ring2& cell, const Wirefra
   });
 }
 
-// Counter-clockwise convex hull of `points` (Andrew's monotone chain; sorts them) into `hull`,
-// whose storage is reused.
-void Hull(Ring2* points, Ring2* hull) {
-  std::sort(points->begin(), points->end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
-  });
-  Ring2& h = *hull;
-  h.resize(2 * points->size());
-  size_t k = 0;
-  for (size_t pass = 0; pass < 2; ++pass) {
-    const size_t start = k;
-    for (const Eigen::Vector2d& p : *points) {
-      while (k >= start + 2 && Cross2(h[k - 1] - h[k - 2], p - h[k - 2]) <= 0.0)
-        --k;
-      h[k++] = p;
-    }
-    --k;  // the last point starts the other chain
-    std::reverse(points->begin(), points->end());
-  }
-  h.resize(std::max<size_t>(k, 1));
-}
-
 // A convex polygon of a few vertices, on the stack.
 struct SmallRing {
   static constexpr size_t kCapacity = 64;
@@ -242,7 +220,7 @@ void OccludersOfFootprint(const Ring2& ring, const Ring2& footprint, const Store
                           std::vector<CellOccluder>* out) {
   points->assign(ring.begin(), ring.end());
   points->insert(points->end(), footprint.begin(), footprint.end());
-  Hull(points, &axes->hull);
+  ConvexHull(points, &axes->hull);
   ComputeAxes(axes);
   const Ring2& hull = axes->hull;
   Eigen::Vector2d lo = ring.front(), hi = lo;

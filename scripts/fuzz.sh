@@ -14,6 +14,7 @@ declare -A seeds=(
   [pose_file_fuzzer]="tests/data/pose_seeds"
   [angles_fuzzer]="tests/data/angles_seeds"
   [batch_fuzzer]="tests/data/batch_seeds"
+  [lines_fuzzer]="tests/data/lines_seeds"
 )
 for name in "${!seeds[@]}"; do
   fuzzer="$fuzz_dir/$name"

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "app/commands.h"
@@ -32,9 +33,11 @@ struct BenchBuildingOptions {
   BuildingSpec spec;
   int count = 100;  // scenes per room and prior
   uint64_t seed = 1;
-  int max_rooms = 0;  // 0: every room
+  int max_rooms = 0;              // 0: every room
+  std::string localize = "both";  // which models localise: "both", "building" or "alone"
   std::string out_path;
   std::string regions_path;  // every region of the building, to compare two builds
+  std::string scenes_path;   // one JSON line per localisation, for the analysis of the table
   int regions_threads = 0;   // ViewInvariantRegionsOptions::threads of the building's regions
 };
 
@@ -81,16 +84,46 @@ Setup Prepare(const CaoModel& cao, const CameraIntrinsics& camera, int regions_t
   return s;
 }
 
-// The localize times (milliseconds) and candidate edges of a series of scenes.
+// The localize times (milliseconds) and candidate edges of a series of scenes, and one JSON
+// object per localisation when `scenes` is set.
 struct LocalizeCosts {
   std::vector<double> times;
   std::vector<double> candidates;
+  std::ostream* scenes = nullptr;
 };
+
+// What a series of scenes is, for the per-scene lines: the room (its free rectangle, metres),
+// the prior's quality index, and which model ("building" or "alone").
+struct SeriesLabel {
+  const BuildingSpace* room = nullptr;
+  int qi = 0;
+  const char* model = "";
+};
+
+// How far past a room's free rectangle its own edges reach (metres): the wall (0.2 m), the door's
+// leaf on its far side and the casing.
+constexpr double kWallMargin = 0.35;
+
+// Candidate edges of `ids` with no end within the room's rectangle grown by `margin` (metres):
+// edges of other spaces, seen through the door.
+int ForeignEdges(const WireframeModel& model, const std::vector<int>& ids,
+                 const BuildingSpace& room, double margin) {
+  const auto inside = [&](const Eigen::Vector3d& p) {
+    return p.x() >= room.lo.x() - margin && p.x() <= room.hi.x() + margin &&
+           p.y() >= room.lo.y() - margin && p.y() <= room.hi.y() + margin;
+  };
+  int foreign = 0;
+  for (int id : ids) {
+    const Segment3& s = model.edges()[id].segment;
+    foreign += inside(s.a) || inside(s.b) ? 0 : 1;
+  }
+  return foreign;
+}
 
 // Correct answers of `count` scenes drawn in `sampling` (poses on `storey`), their costs appended
 // to `costs`.
 int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticSceneOptions o,
-                   LocalizeCosts* costs) {
+                   const SeriesLabel& label, LocalizeCosts* costs) {
   const std::vector<SyntheticScene> scenes = GenerateScenes(*setup.model, sampling, o);
   int correct = 0;
   for (const SyntheticScene& scene : scenes) {
@@ -99,7 +132,29 @@ int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticS
     const LocalizationResult result = setup.localizer->Localize(problem);
     costs->times.push_back(MsSince(start));
     costs->candidates.push_back(result.candidate_edges);
-    correct += JudgeScene(scene, result) == MatchOutcome::kCorrect ? 1 : 0;
+    const MatchOutcome outcome = JudgeScene(scene, result);
+    correct += outcome == MatchOutcome::kCorrect ? 1 : 0;
+    if (costs->scenes == nullptr) continue;
+    const nlohmann::ordered_json row = {
+        {"room", label.room->name},
+        {"qi", label.qi},
+        {"model", label.model},
+        {"scene", scene.index},
+        {"lines", scene.lines.size()},
+        {"prior", {scene.prior.x, scene.prior.y, RadToDeg(scene.prior.heading)}},
+        {"delta_t", scene.delta_t},
+        {"truth", {scene.truth.x, scene.truth.y, RadToDeg(scene.truth.heading)}},
+        {"candidates", result.candidate_edges},
+        {"foreign", ForeignEdges(*setup.model, setup.localizer->CandidateEdges(problem),
+                                 *label.room, kWallMargin)},
+        {"tree_nodes", result.tree_nodes},
+        {"tree_checks", result.tree_checks},
+        {"hypotheses", result.hypotheses},
+        {"exhausted", result.budget_exhausted},
+        {"outcome", MatchOutcomeName(outcome)},
+        {"reason", result.reason},
+        {"ms", costs->times.back()}};
+    *costs->scenes << row.dump() << '\n';
   }
   return correct;
 }
@@ -157,6 +212,8 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
       << "| room | QI1 building | QI1 alone | QI2 building | QI2 alone | QI3 building | "
          "QI3 alone |\n| --- | --- | --- | --- | --- | --- | --- |\n";
   LocalizeCosts building_costs, alone_costs;
+  std::ostringstream scenes;
+  if (!opt.scenes_path.empty()) building_costs.scenes = alone_costs.scenes = &scenes;
   std::array<int, 3> sum_building{}, sum_alone{};
   int done = 0;
   for (size_t k = 0; k < building.spaces.size(); ++k) {
@@ -176,9 +233,15 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
       o.delta_phi = bounds.delta_phi;
       o.floor_z = room.floor_z;
       o.storey = room.storey;
-      const int b = CorrectAnswers(whole, sampling, o, &building_costs);
+      // One model only, for a profiler that counts a model's localisations alone.
+      const int b =
+          opt.localize == "alone"
+              ? 0
+              : CorrectAnswers(whole, sampling, o, {&room, qi, "building"}, &building_costs);
       o.storey = 0;
-      const int a = CorrectAnswers(alone, *alone.area, o, &alone_costs);
+      const int a = opt.localize == "building"
+                        ? 0
+                        : CorrectAnswers(alone, *alone.area, o, {&room, qi, "alone"}, &alone_costs);
       sum_building[qi - 1] += b;
       sum_alone[qi - 1] += a;
       out << " | " << b << " | " << a;
@@ -201,6 +264,7 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
   out << line;
   std::cout << out.str();
   if (!opt.out_path.empty()) WriteFileAtomically(opt.out_path, out.str());
+  if (!opt.scenes_path.empty()) WriteFileAtomically(opt.scenes_path, scenes.str());
   return kExitOk;
 }
 
@@ -219,6 +283,11 @@ void AddBenchBuilding(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--seed", opt->seed, "Seed of the scenes")->capture_default_str();
   cmd->add_option("--rooms", opt->max_rooms, "Only the first N rooms (0: all)")
       ->capture_default_str();
+  cmd->add_option("--localize", opt->localize,
+                  "Which models localise the scenes (the other's columns are 0): both, building or "
+                  "alone")
+      ->check(CLI::IsMember({"both", "building", "alone"}))
+      ->capture_default_str();
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->add_option("--regions-threads", opt->regions_threads,
                   "Threads building the regions' lists (0: one per hardware thread)")
@@ -226,6 +295,9 @@ void AddBenchBuilding(CLI::App& cli, CommandAction* action) {
   cmd->add_option("--regions-out", opt->regions_path,
                   "Write every region of the building (storey, polygon, list) to this file, to "
                   "compare two builds");
+  cmd->add_option("--scenes-out", opt->scenes_path,
+                  "Write one JSON line per localisation (room, prior, model, candidate edges and "
+                  "those of other spaces, tree work, outcome, time) to this file");
   cmd->callback([opt, action] {
     if (opt->count < 1) throw CLI::ValidationError("--count", "must be at least 1");
     if (opt->regions_threads < 0 || opt->regions_threads > 256)

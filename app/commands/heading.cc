@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "app/line_flags.h"
+#include "app/lines_csv.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "app/model_loading.h"

@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/image_overlay.h"
 #include "app/integrity_output.h"
+#include "app/lines_csv.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "matching/evaluation/baseline_sampler.h"

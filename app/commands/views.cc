@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/image_overlay.h"
 #include "app/line_flags.h"
+#include "app/lines_csv.h"
 #include "app/localize_image.h"
 #include "app/localize_io.h"
 #include "app/model_loading.h"

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "app/localize_io.h"
+#include "app/lines_csv.h"
 #include "matching/lines/line_extractor.h"
 #include "models/render/scene_renderer.h"
 #include "models/robot_pose.h"

@@ -139,6 +139,60 @@ TEST_F(Building, RegionsKeepEachStoreyToItsOwnEdges) {
   }
 }
 
+// From a room's corner by its neighbour's wall, looking past its door: the query keeps few edges
+// of other spaces that ray casting never sees from the disk (behind the room's corners, which
+// neither wall hides alone), and misses none it sees.
+TEST_F(Building, QueryPastARoomsCornerKeepsLittleItCannotSee) {
+  const ViewInvariantRegions regions = ViewInvariantRegions::Build(*model_, *area_);
+  const OcclusionTester occlusion(*model_);
+  const CameraIntrinsics camera = PaperSyntheticCamera();
+  const BuildingSpace& room = building_->spaces[1];  // s0-south-1: x 4.4-8, y 0.2-4.2, door north
+  ASSERT_EQ(room.name, "s0-south-1");
+  constexpr double kTilt = 0.05, kHeight = 1.35;  // radians, metres
+  VisibilityQuery query;
+  query.centre = {4.59, 3.50};
+  query.radius = 0.3;
+  query.heading = DegToRad(13.2);
+  query.heading_margin = DegToRad(10.0);
+  query.bearing_half_width = BearingHalfWidth(camera, kTilt, kTilt);
+  query.camera_z = kHeight;
+  const std::vector<int> ids = regions.Query(query);
+  constexpr double kOwn = 0.35;  // a room's own edges reach this far past its free rectangle
+  const auto own = [&](const Eigen::Vector3d& p) {
+    return p.x() >= room.lo.x() - kOwn && p.x() <= room.hi.x() + kOwn &&
+           p.y() >= room.lo.y() - kOwn && p.y() <= room.hi.y() + kOwn;
+  };
+  std::mt19937 rng(3u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<char> seen(model_->edges().size(), 0);
+  int misses = 0;
+  for (int i = 0; i < 600; ++i) {
+    const double r = query.radius * (i % 3 == 0 ? 1.0 : std::sqrt(unit(rng)));
+    const double a = 2.0 * kPi * unit(rng);
+    const Eigen::Vector2d p = query.centre + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+    if (!area_->Contains(p, 0)) continue;
+    const RobotPose pose{p.x(), p.y(),
+                         query.heading + query.heading_margin * (2.0 * unit(rng) - 1.0), kHeight,
+                         kTilt};
+    for (const ProjectedEdge& piece :
+         ProjectVisibleEdges(*model_, occlusion, CamFromWorld(pose), camera)) {
+      seen[piece.edge_id] = 1;
+      misses += std::binary_search(ids.begin(), ids.end(), piece.edge_id) ? 0 : 1;
+    }
+  }
+  int other = 0, other_seen = 0;
+  for (int id : ids) {
+    const Segment3& s = model_->edges()[id].segment;
+    if (own(s.a) || own(s.b)) continue;
+    ++other;
+    other_seen += seen[id];
+  }
+  EXPECT_EQ(misses, 0);
+  EXPECT_GT(other_seen, 5);  // the corridor and the room across, through the door
+  // 81 edges of other spaces before corners were tested (10 seen); 27 with them.
+  EXPECT_LE(other - other_seen, 20);
+}
+
 TEST_F(Building, PassesTheModelChecks) {
   const std::vector<ModelFinding> findings = CheckModel(*model_);
   EXPECT_TRUE(findings.empty()) << findings.front().message;

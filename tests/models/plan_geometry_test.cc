@@ -184,6 +184,102 @@ TEST(PlanVisibility, HiddenTestsAgreeWithSampledSightLines) {
   EXPECT_GT(hidden_by_wall, 10);
 }
 
+// True when the sight line p -> q crosses the segment `wall` (strictly between its sides).
+bool Crosses(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Segment2& wall) {
+  const Line2 line = Line2::Through(wall.a, wall.b);
+  const double sp = line.SignedDistance(p), sq = line.SignedDistance(q);
+  if (!(sp * sq < 0.0)) return false;
+  const Eigen::Vector2d x = p + sp / (sp - sq) * (q - p);
+  const double along = (x - wall.a).dot(wall.b - wall.a) / (wall.b - wall.a).squaredNorm();
+  return along >= 0.0 && along <= 1.0;
+}
+
+TEST(PlanVisibility, CornerHidesWhatNeitherWallHidesAlone) {
+  // A room's corner at (4, 4): its north wall from (1, 4), its east wall from (4, 0). A point far
+  // to the north-east seen past the corner from inside the room.
+  const Ring2 eyes = Box(1.0, 1.0, 3.5, 3.5);
+  const Eigen::Vector2d corner(4.0, 4.0), north(1.0, 4.0), east(4.0, 0.0);
+  const Ring2 far = {{12.0, 6.0}};
+  EXPECT_FALSE(HiddenByWall(eyes, far, {north, corner}, kMarginM));
+  EXPECT_FALSE(HiddenByWall(eyes, far, {east, corner}, kMarginM));
+  EXPECT_TRUE(HiddenByCorner(eyes, far, corner, north, east, kMarginM));
+  EXPECT_TRUE(HiddenByCorner(eyes, far, corner, east, north, kMarginM));
+  // A point to the north, past the corner too; with a door in the north wall (the wall starts at
+  // x = 2.5), seen through it.
+  const Ring2 north_far = {{6.0, 12.0}};
+  EXPECT_TRUE(HiddenByCorner(eyes, north_far, corner, north, east, kMarginM));
+  EXPECT_FALSE(HiddenByCorner(eyes, north_far, corner, {2.5, 4.0}, east, kMarginM));
+  // In front of the north wall's line: not behind the corner.
+  EXPECT_FALSE(HiddenByCorner(eyes, {{12.0, 3.9}}, corner, north, east, kMarginM));
+  // The same walls seen from outside the room (the corner reflex): no claim.
+  EXPECT_FALSE(
+      HiddenByCorner(Box(5.0, 5.0, 6.0, 6.0), {{2.0, 2.0}}, corner, north, east, kMarginM));
+}
+
+TEST(PlanVisibility, CornerTestAgreesWithSampledSightLines) {
+  std::mt19937 rng(7u);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int hidden = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    // Two walls from a corner near the origin at an angle of 30-150 degrees, eyes on one side.
+    const Eigen::Vector2d corner(unit(rng) - 0.5, unit(rng) - 0.5);
+    const double a = 2.0 * kPi * unit(rng), b = a + DegToRad(30.0 + 120.0 * unit(rng));
+    const Eigen::Vector2d far_a =
+        corner + (1.0 + 3.0 * unit(rng)) * Eigen::Vector2d(std::cos(a), std::sin(a));
+    const Eigen::Vector2d far_b =
+        corner + (1.0 + 3.0 * unit(rng)) * Eigen::Vector2d(std::cos(b), std::sin(b));
+    const Eigen::Vector2d inside = corner + 0.5 * (far_a - corner) + 0.5 * (far_b - corner);
+    const Ring2 eyes =
+        RandomBox(inside + 0.5 * Eigen::Vector2d(unit(rng) - 0.5, unit(rng) - 0.5), 0.4, &rng);
+    const Eigen::Vector2d f0 = corner + 4.0 * (corner - inside).normalized() +
+                               3.0 * Eigen::Vector2d(unit(rng) - 0.5, unit(rng) - 0.5);
+    const Ring2 footprint =
+        trial % 2 ? Ring2{f0} : Ring2{f0, f0 + Eigen::Vector2d(unit(rng) - 0.5, unit(rng) - 0.5)};
+    if (!HiddenByCorner(eyes, footprint, corner, far_a, far_b, kMarginM)) continue;
+    ++hidden;
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector2d p = k < 4 ? eyes[k] : PointIn(eyes, &rng);
+      const Eigen::Vector2d q = footprint.size() == 1
+                                    ? footprint[0]
+                                    : footprint[0] + unit(rng) * (footprint[1] - footprint[0]);
+      ASSERT_TRUE(Crosses(p, q, {far_a, corner}) || Crosses(p, q, {far_b, corner}))
+          << "trial " << trial << ": a sight line passes the corner";
+    }
+  }
+  EXPECT_GT(hidden, 100);  // the configurations do exercise both outcomes
+  EXPECT_LT(hidden, 2900);
+}
+
+TEST(PlanVisibility, WallCornersPairTheWallsThatMeet) {
+  // An L of two walls, a third collinear with the first, and one apart.
+  const std::vector<Segment2> walls = {{{0.0, 0.0}, {2.0, 0.0}},
+                                       {{2.0, 0.0}, {2.0, 3.0}},
+                                       {{2.0, 0.0}, {5.0, 0.0}},
+                                       {{9.0, 9.0}, {9.0, 8.0}}};
+  const std::vector<std::vector<WallCorner>> corners = WallCorners(walls, 1e-6);
+  ASSERT_EQ(corners.size(), 4u);
+  ASSERT_EQ(corners[0].size(), 1u);  // the collinear one makes no corner
+  EXPECT_EQ(corners[0][0].corner, Eigen::Vector2d(2.0, 0.0));
+  EXPECT_EQ(corners[0][0].far_self, Eigen::Vector2d(0.0, 0.0));
+  EXPECT_EQ(corners[0][0].far_other, Eigen::Vector2d(2.0, 3.0));
+  EXPECT_EQ(corners[1].size(), 2u);
+  EXPECT_EQ(corners[2].size(), 1u);
+  EXPECT_TRUE(corners[3].empty());
+}
+
+TEST(ConvexRing, ClipAndHullOfBoxes) {
+  const Ring2 half = ClipConvex(Box(0, 0, 2, 2), {Eigen::Vector2d::UnitX(), 0.5});
+  EXPECT_NEAR(RingSignedArea(half), 3.0, kTol);
+  EXPECT_TRUE(ClipConvex(Box(0, 0, 2, 2), {Eigen::Vector2d::UnitX(), 3.0}).empty());
+  Ring2 points = Box(0, 0, 1, 1), hull;
+  const Ring2 other = Box(2, 0, 3, 1);
+  points.insert(points.end(), other.begin(), other.end());
+  points.push_back({1.5, 0.5});  // inside the hull
+  ConvexHull(&points, &hull);
+  EXPECT_EQ(hull.size(), 4u);
+  EXPECT_NEAR(RingSignedArea(hull), 3.0, kTol);
+}
+
 TEST(PlanVisibility, BearingRangeHoldsEverySampledBearingAndIsTight) {
   std::mt19937 rng(9u);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
