@@ -35,11 +35,13 @@ constexpr double kCsvTolPx = 1e-3;  // the CSV keeps three decimals
 // End to end from rendered images (generous: the matcher is not under test here).
 constexpr double kPositionTolM = 0.2;
 constexpr double kHeadingTolDeg = 3.0;
-// A single view's protection levels are 0.16-0.74 m for these four (the default 0.10 m alert
-// limit answers none of them): a limit a single-image answer meets.
+// A single view's protection levels are 0.1-2 m for these four (the default 0.10 m alert limit
+// answers none of them): a limit a single-image answer meets.
 constexpr double kAlertLimitM = 1.0;
 const std::string kAlertLimit = "1,5";
-constexpr int kMinAnswered = 4;
+// Of 4 views: at (7, 2) an edge fault's protection level (1.9 m with the frame lines' casing
+// allowance) exceeds even this alert limit.
+constexpr int kMinAnswered = 3;
 
 int Lines(const std::string& text) {
   int n = 0;

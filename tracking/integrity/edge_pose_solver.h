@@ -35,9 +35,9 @@ struct EdgeNoiseOptions {
   // A frame line's edge (EdgeObservation::casing_direction) may be pulled onto a casing beside
   // it: a shift of the whole edge by c ~ N(0, casing_sigma_m^2) metres along that direction, whose
   // image offsets k c at the two ends (CasingOffsets) add casing_sigma_m^2 k k' to the edge's
-  // covariance. Door casings are 5-10 cm wide (0.05 on drives past casings; off by default: it
-  // widens every frame line's error, cased or not, docs/integrity.md section 1.5).
-  double casing_sigma_m = 0.0;
+  // covariance. Door casings are 5-10 cm wide; the moving edges latch on their outer border
+  // (docs/integrity.md section 1.3). 0: frame lines are trusted like face edges.
+  double casing_sigma_m = 0.05;
   // The edge-level covariance is scaled by lambda >= 1, chosen so that the median over edges of
   // the edges' own offsets' chi-square matches chi2(2)'s (robust to a faulty edge); at most this.
   bool estimate_edge_scale = true;
