@@ -198,9 +198,7 @@ bool SplitConvex(const Ring2& convex, const Line2& line, double min_area, Ring2*
 }
 
 void ConvexHull(Ring2* points, Ring2* hull) {
-  std::sort(points->begin(), points->end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
-  });
+  std::sort(points->begin(), points->end(), LexicographicLess);
   Ring2& h = *hull;
   h.resize(2 * points->size());
   size_t k = 0;

@@ -54,6 +54,12 @@ bool SplitConvex(const Ring2& convex, const Line2& line, double min_area, Ring2*
 // the segment misses it.
 bool ClipSegmentToConvex(const Ring2& convex, const Segment2& s, double* t0, double* t1);
 
+// Lexicographic order of plan points (x, then y): the hull's sweep order, and a canonical order
+// for comparing point sets.
+inline bool LexicographicLess(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+}
+
 // Counter-clockwise convex hull of `points` (Andrew's monotone chain; sorts them) into `hull`,
 // whose storage is reused. Collinear points are left out; one point for coincident points.
 void ConvexHull(Ring2* points, Ring2* hull);

@@ -68,9 +68,7 @@ std::vector<Eigen::Vector2d> PlanPoints(const WireframeModel& model, const std::
     for (const Eigen::Vector3d& end : {model.edges()[id].segment.a, model.edges()[id].segment.b})
       points.push_back(end.head<2>());
   }
-  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
-  });
+  std::sort(points.begin(), points.end(), LexicographicLess);
   std::vector<Eigen::Vector2d> distinct;
   for (const Eigen::Vector2d& p : points) {
     const bool known = std::any_of(distinct.rbegin(), distinct.rend(),
@@ -131,9 +129,7 @@ StoreyEdges EdgesOfStorey(const WireframeModel& model, const std::vector<Storey>
   std::map<std::pair<char, std::vector<double>>, int> first;
   for (size_t k = 0; k < edges.ids.size(); ++k) {
     Ring2 points = edges.footprints[k];
-    std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-      return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
-    });
+    std::sort(points.begin(), points.end(), LexicographicLess);
     std::vector<double> key;
     for (const Eigen::Vector2d& p : points)
       key.insert(key.end(), {p.x(), p.y()});
