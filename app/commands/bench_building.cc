@@ -39,6 +39,9 @@ struct BenchBuildingOptions {
   std::string regions_path;  // every region of the building, to compare two builds
   std::string scenes_path;   // one JSON line per localisation, for the analysis of the table
   int regions_threads = 0;   // ViewInvariantRegionsOptions::threads of the building's regions
+  // Localise the same lines with both models: the scenes drawn in the building whose view sees
+  // nothing through the door (false: each model draws its own scenes).
+  bool paired = false;
 };
 
 double MsSince(Clock::time_point start) {
@@ -120,11 +123,40 @@ int ForeignEdges(const WireframeModel& model, const std::vector<int>& ids,
   return foreign;
 }
 
-// Correct answers of `count` scenes drawn in `sampling` (poses on `storey`), their costs appended
-// to `costs`.
-int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticSceneOptions o,
+// For each edge of `from`, the edge of `to` with the same segment (either direction, within
+// 1 mm), or -1: the models of a room alone and of the building share world coordinates.
+std::vector<int> SameEdges(const WireframeModel& from, const WireframeModel& to) {
+  constexpr double kSameM = 1e-3;
+  const auto same = [](const Segment3& s, const Segment3& t) {
+    return ((s.a - t.a).norm() < kSameM && (s.b - t.b).norm() < kSameM) ||
+           ((s.a - t.b).norm() < kSameM && (s.b - t.a).norm() < kSameM);
+  };
+  std::vector<int> map(from.edges().size(), -1);
+  for (size_t i = 0; i < from.edges().size(); ++i) {
+    for (const ModelEdge& e : to.edges()) {
+      if (same(from.edges()[i].segment, e.segment)) map[i] = e.id;
+    }
+  }
+  return map;
+}
+
+// True when every model line of `scene` images an edge that the other model has too (`map`,
+// from SameEdges): the view sees nothing through the door, so the room alone can explain the
+// same lines. `moved` gets the scene with its correspondences in the other model's edge ids.
+bool SameImageInOtherModel(const SyntheticScene& scene, const std::vector<int>& map,
+                           SyntheticScene* moved) {
+  *moved = scene;
+  for (auto& match : moved->matches) {
+    if (map[match.first] < 0) return false;
+    match.first = map[match.first];
+  }
+  std::sort(moved->matches.begin(), moved->matches.end());
+  return true;
+}
+
+// Correct answers of `scenes` localised by `setup`, their costs appended to `costs`.
+int CorrectAnswers(const Setup& setup, const std::vector<SyntheticScene>& scenes,
                    const SeriesLabel& label, LocalizeCosts* costs) {
-  const std::vector<SyntheticScene> scenes = GenerateScenes(*setup.model, sampling, o);
   int correct = 0;
   for (const SyntheticScene& scene : scenes) {
     const LocalizationProblem problem = ProblemOf(scene);
@@ -152,6 +184,9 @@ int CorrectAnswers(const Setup& setup, const NavigableArea& sampling, SyntheticS
         {"hypotheses", result.hypotheses},
         {"exhausted", result.budget_exhausted},
         {"outcome", MatchOutcomeName(outcome)},
+        {"answer", result.found ? nlohmann::ordered_json{result.pose.x, result.pose.y,
+                                                         RadToDeg(result.pose.heading)}
+                                : nlohmann::ordered_json()},
         {"reason", result.reason},
         {"ms", costs->times.back()}};
     *costs->scenes << row.dump() << '\n';
@@ -188,6 +223,16 @@ std::string RegionsText(const ViewInvariantRegions& regions) {
   return out.str();
 }
 
+// What the table's counts are out of.
+std::string Caption(const BenchBuildingOptions& opt, int scenes_per_model, int drawn) {
+  if (!opt.paired) {
+    return "correct of " + std::to_string(opt.count) + " scenes per room and prior";
+  }
+  return "correct of the scenes drawn in the building whose view sees nothing through the door (" +
+         std::to_string(scenes_per_model) + " of " + std::to_string(drawn) + " drawn, " +
+         std::to_string(opt.count) + " per room and prior), the same lines for both models";
+}
+
 int RunBenchBuilding(const BenchBuildingOptions& opt) {
   const CameraIntrinsics camera = PaperSyntheticCamera();
   const SyntheticBuilding building = GenerateBuilding(opt.spec);
@@ -196,7 +241,7 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
   const double rss_after = MaxRssMb();
   if (!opt.regions_path.empty()) WriteFileAtomically(opt.regions_path, RegionsText(*whole.regions));
   std::ostringstream out;
-  char line[256];
+  char line[512];
   int rooms = 0;
   for (const BuildingSpace& space : building.spaces)
     rooms += space.corridor ? 0 : 1;
@@ -215,7 +260,7 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
   std::ostringstream scenes;
   if (!opt.scenes_path.empty()) building_costs.scenes = alone_costs.scenes = &scenes;
   std::array<int, 3> sum_building{}, sum_alone{};
-  int done = 0;
+  int done = 0, scenes_per_model = 0;
   for (size_t k = 0; k < building.spaces.size(); ++k) {
     const BuildingSpace& room = building.spaces[k];
     if (room.corridor || (opt.max_rooms > 0 && done >= opt.max_rooms)) continue;
@@ -223,6 +268,8 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
     const Setup alone =
         Prepare(SpaceAlone(opt.spec, static_cast<int>(k)), camera, opt.regions_threads);
     const NavigableArea sampling = RoomArea(*alone.area, room.storey, whole.model->storeys());
+    const std::vector<int> alone_edges =
+        opt.paired ? SameEdges(*whole.model, *alone.model) : std::vector<int>{};
     out << "| " << room.name;
     for (int qi = 1; qi <= 3; ++qi) {
       SyntheticSceneOptions o;
@@ -233,15 +280,34 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
       o.delta_phi = bounds.delta_phi;
       o.floor_z = room.floor_z;
       o.storey = room.storey;
-      // One model only, for a profiler that counts a model's localisations alone.
+      // Each model's scenes: drawn in it, or (paired) the building's whose view sees nothing
+      // through the door, in both. One model only localises for a profiler that counts a
+      // model's localisations alone.
+      std::vector<SyntheticScene> in_building = opt.localize == "alone" && !opt.paired
+                                                    ? std::vector<SyntheticScene>{}
+                                                    : GenerateScenes(*whole.model, sampling, o);
+      std::vector<SyntheticScene> in_alone;
+      if (opt.paired) {
+        std::vector<SyntheticScene> kept;
+        for (const SyntheticScene& scene : in_building) {
+          SyntheticScene moved;
+          if (!SameImageInOtherModel(scene, alone_edges, &moved)) continue;
+          kept.push_back(scene);
+          in_alone.push_back(std::move(moved));
+        }
+        in_building = std::move(kept);
+      } else if (opt.localize != "building") {
+        o.storey = 0;
+        in_alone = GenerateScenes(*alone.model, *alone.area, o);
+      }
+      scenes_per_model += static_cast<int>(std::max(in_building.size(), in_alone.size()));
       const int b =
           opt.localize == "alone"
               ? 0
-              : CorrectAnswers(whole, sampling, o, {&room, qi, "building"}, &building_costs);
-      o.storey = 0;
+              : CorrectAnswers(whole, in_building, {&room, qi, "building"}, &building_costs);
       const int a = opt.localize == "building"
                         ? 0
-                        : CorrectAnswers(alone, *alone.area, o, {&room, qi, "alone"}, &alone_costs);
+                        : CorrectAnswers(alone, in_alone, {&room, qi, "alone"}, &alone_costs);
       sum_building[qi - 1] += b;
       sum_alone[qi - 1] += a;
       out << " | " << b << " | " << a;
@@ -255,10 +321,11 @@ int RunBenchBuilding(const BenchBuildingOptions& opt) {
     out << "| **" << sum_building[qi] << "** | **" << sum_alone[qi] << "** ";
   const double t_building = Median(building_costs.times), t_alone = Median(alone_costs.times);
   std::snprintf(line, sizeof(line),
-                "|\n\ncorrect of %d scenes per room and prior (seed %llu)\nlocalize median: "
+                "|\n\n%s (seed %llu)\nlocalize median: "
                 "building %.3f ms, rooms alone %.3f ms (x %.2f)\ncandidate edges median: "
                 "building %.0f, rooms alone %.0f\n",
-                opt.count, static_cast<unsigned long long>(opt.seed), t_building, t_alone,
+                Caption(opt, scenes_per_model, 3 * done * opt.count).c_str(),
+                static_cast<unsigned long long>(opt.seed), t_building, t_alone,
                 t_building / std::max(1e-9, t_alone), Median(building_costs.candidates),
                 Median(alone_costs.candidates));
   out << line;
@@ -288,6 +355,9 @@ void AddBenchBuilding(CLI::App& cli, CommandAction* action) {
                   "alone")
       ->check(CLI::IsMember({"both", "building", "alone"}))
       ->capture_default_str();
+  cmd->add_flag("--paired", opt->paired,
+                "Localise the same lines with both models: the scenes drawn in the building whose "
+                "view sees nothing through the door (default: each model draws its own scenes)");
   cmd->add_option("--out", opt->out_path, "Also write the table (Markdown) to this file");
   cmd->add_option("--regions-threads", opt->regions_threads,
                   "Threads building the regions' lists (0: one per hardware thread)")
