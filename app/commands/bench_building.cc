@@ -154,6 +154,47 @@ bool SameImageInOtherModel(const SyntheticScene& scene, const std::vector<int>& 
   return true;
 }
 
+// One localisation's line for --scenes-out; a wrong answer also gets the truth's own
+// verification (DiagnoseTruth): was the truth plausible, and with what evidence (nats)?
+nlohmann::ordered_json SceneRow(const Setup& setup, const SyntheticScene& scene,
+                                const LocalizationProblem& problem,
+                                const LocalizationResult& result, MatchOutcome outcome,
+                                const SeriesLabel& label, double ms) {
+  nlohmann::ordered_json row = {
+      {"room", label.room->name},
+      {"qi", label.qi},
+      {"model", label.model},
+      {"scene", scene.index},
+      {"lines", scene.lines.size()},
+      {"prior", {scene.prior.x, scene.prior.y, RadToDeg(scene.prior.heading)}},
+      {"delta_t", scene.delta_t},
+      {"truth", {scene.truth.x, scene.truth.y, RadToDeg(scene.truth.heading)}},
+      {"candidates", result.candidate_edges},
+      {"foreign", ForeignEdges(*setup.model, setup.localizer->CandidateEdges(problem), *label.room,
+                               kWallMargin)},
+      {"tree_nodes", result.tree_nodes},
+      {"tree_checks", result.tree_checks},
+      {"hypotheses", result.hypotheses},
+      {"exhausted", result.budget_exhausted},
+      {"completed_bound", result.tree_completed_bound},
+      {"unexplained_bound", result.unexplained_completed_bound},
+      {"score", result.finalists.empty() ? 0.0 : result.finalists.front().evidence.Score()},
+      {"outcome", MatchOutcomeName(outcome)},
+      {"answer", result.found ? nlohmann::ordered_json{result.pose.x, result.pose.y,
+                                                       RadToDeg(result.pose.heading)}
+                              : nlohmann::ordered_json()},
+      {"reason", result.reason},
+      {"ms", ms}};
+  if (outcome == MatchOutcome::kWrong) {
+    const TruthDiagnosis truth =
+        DiagnoseTruth(*setup.localizer, problem, scene.truth.Planar(), scene.matches);
+    row["truth_plausible"] = truth.plausible;
+    row["truth_evidence"] = truth.evidence_score;
+    row["truth_why"] = truth.implausible_because;
+  }
+  return row;
+}
+
 // Correct answers of `scenes` localised by `setup`, their costs appended to `costs`.
 int CorrectAnswers(const Setup& setup, const std::vector<SyntheticScene>& scenes,
                    const SeriesLabel& label, LocalizeCosts* costs) {
@@ -167,29 +208,9 @@ int CorrectAnswers(const Setup& setup, const std::vector<SyntheticScene>& scenes
     const MatchOutcome outcome = JudgeScene(scene, result);
     correct += outcome == MatchOutcome::kCorrect ? 1 : 0;
     if (costs->scenes == nullptr) continue;
-    const nlohmann::ordered_json row = {
-        {"room", label.room->name},
-        {"qi", label.qi},
-        {"model", label.model},
-        {"scene", scene.index},
-        {"lines", scene.lines.size()},
-        {"prior", {scene.prior.x, scene.prior.y, RadToDeg(scene.prior.heading)}},
-        {"delta_t", scene.delta_t},
-        {"truth", {scene.truth.x, scene.truth.y, RadToDeg(scene.truth.heading)}},
-        {"candidates", result.candidate_edges},
-        {"foreign", ForeignEdges(*setup.model, setup.localizer->CandidateEdges(problem),
-                                 *label.room, kWallMargin)},
-        {"tree_nodes", result.tree_nodes},
-        {"tree_checks", result.tree_checks},
-        {"hypotheses", result.hypotheses},
-        {"exhausted", result.budget_exhausted},
-        {"outcome", MatchOutcomeName(outcome)},
-        {"answer", result.found ? nlohmann::ordered_json{result.pose.x, result.pose.y,
-                                                         RadToDeg(result.pose.heading)}
-                                : nlohmann::ordered_json()},
-        {"reason", result.reason},
-        {"ms", costs->times.back()}};
-    *costs->scenes << row.dump() << '\n';
+    *costs->scenes
+        << SceneRow(setup, scene, problem, result, outcome, label, costs->times.back()).dump()
+        << '\n';
   }
   return correct;
 }
