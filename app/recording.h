@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/head_mount.h"
 #include "models/camera.h"
 #include "models/trajectory_io.h"
 #include "tracking/capture/frame_source.h"
@@ -23,7 +24,10 @@ struct RecordingOptions {
   double height = 0.0;                                 // camera above the base's origin (m)
   double tilt = 0.0;                                   // radians, without a tilt joint
   std::optional<Pose3Dof> start;  // the base's pose in the map at the first frame (--prior)
-  std::string out_bag;            // poses and map -> odom written here (empty: none)
+  // The camera on a calibrated pan-tilt head (--mount): its mount from the joint angles
+  // (MountOnHead), `height` unused; none: the optical centre at `height` on the pan axis.
+  std::optional<BelievedHead> head;
+  std::string out_bag;  // poses and map -> odom written here (empty: none)
 };
 
 class Recording {

@@ -112,15 +112,16 @@ void GrabFirstFrame(const ReplayOptions& opt, ReplaySetup* s) {
 // A recording (rosbag): its odometry is the prior file, --prior moves it to the map.
 void PrepareRecording(const ReplayOptions& opt, ReplaySetup* s) {
   if (!opt.open_recording) throw InputError(opt.input + ": this build cannot read rosbag files");
-  if (!opt.mount.empty()) {
-    throw InputError(
-        "replay: --mount applies to videos and image sequences; a bag's camera is "
-        "at --height with its joint states' angles");
-  }
   if (!opt.prior_file.empty()) throw InputError("replay: a bag's odometry replaces --prior-file");
   if (opt.recording.image_topic.empty()) throw InputError("replay: a bag needs --image-topic");
-  if (!opt.has_height) throw InputError("replay: a bag needs --height");
-  CheckHeight(opt.height, "--height");
+  if (!opt.mount.empty()) {
+    if (opt.recording.joint_states_topic.empty() || opt.recording.odom_topic.empty()) {
+      throw InputError("replay: --mount with a bag needs --joint-states-topic and --odom-topic");
+    }
+  } else if (!opt.has_height) {
+    throw InputError("replay: a bag needs --height");
+  }
+  if (opt.has_height) CheckHeight(opt.height, "--height");
   if (opt.has_tilt) CheckRange(opt.tilt_deg, -89.0, 89.0, "--tilt");
   if (!opt.has_tilt && opt.recording.joint_states_topic.empty()) {
     throw InputError("replay: a bag needs --tilt or --joint-states-topic");
@@ -128,6 +129,10 @@ void PrepareRecording(const ReplayOptions& opt, ReplaySetup* s) {
   RecordingOptions options = opt.recording;
   options.height = opt.height;
   options.tilt = opt.has_tilt ? DegToRad(opt.tilt_deg) : 0.0;
+  if (!opt.mount.empty()) {
+    options.head = BelieveHead(HeadModel::kPtu46, ReadMountFile(opt.mount), opt.mount,
+                               opt.has_height ? std::optional<double>(opt.height) : std::nullopt);
+  }
   if (!opt.prior.empty()) options.start = ParsePrior(opt.prior, "--prior");
   s->recording = opt.open_recording(opt.input, options);
   s->priors = s->recording->priors();
@@ -261,6 +266,7 @@ std::optional<RobotReading> ReadingAt(const ReplayOptions& opt, const ReplaySetu
     reading.odometry = prior->Planar();
     reading.height = prior->height;
     reading.tilt = prior->tilt;
+    reading.roll = prior->roll;
   } else {
     reading.height = opt.height;
     reading.tilt = DegToRad(opt.tilt_deg);
@@ -526,9 +532,9 @@ void AddReplayWithRecordings(CLI::App& cli, CommandAction* action, RecordingOpen
   cmd->add_option("--height", opt->height, "Camera height above the floor (metres)");
   cmd->add_option("--tilt", opt->tilt_deg, "Camera tilt below the horizontal (degrees)");
   cmd->add_option("--mount", opt->mount,
-                  "mount.json of linetrack calibrate-mount: --tilt and the prior file's tilt are "
-                  "the head's, the camera's height and tilt follow from the mount (and its floor "
-                  "height, else --height taped with the head level)");
+                  "mount.json of linetrack calibrate-mount: --tilt and the prior file's tilt (a "
+                  "bag's joint states) are the head's, the camera's height and tilt follow from "
+                  "the mount (and its floor height, else --height taped with the head level)");
   cmd->add_option("--delta-t", opt->delta_t, "Position bound of the first prior (metres)")
       ->capture_default_str();
   cmd->add_option("--delta-phi", opt->delta_phi_deg, "Heading bound of the first prior (degrees)")

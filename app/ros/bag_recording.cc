@@ -200,14 +200,15 @@ void RosBagRecording::ReadReadings() {
 }
 
 CameraMount RosBagRecording::MountAt(double t) const {
-  CameraMount mount{options_.height, 0.0, options_.tilt};
   // The nearest reading however far: a bag's joint states start and end with its images.
   const std::optional<StampedHeadAngles> angles =
       HeadAnglesAt(joints_, t, std::numeric_limits<double>::infinity());
-  if (!angles) return mount;
-  mount.pan = angles->pan;
-  mount.tilt = angles->tilt;
-  return mount;
+  const double pan = angles ? angles->pan : 0.0;
+  const double tilt = angles ? angles->tilt : options_.tilt;
+  if (options_.head) {
+    return MountOnHead(options_.head->geometry, options_.head->crossing_height, pan, tilt);
+  }
+  return CameraMount{options_.height, pan, tilt};
 }
 
 void RosBagRecording::Add(double t, const FrameReport& report) {

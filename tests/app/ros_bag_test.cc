@@ -5,7 +5,8 @@
 // integrity failure against the truth), and --out-bag holds the tracking poses with their
 // covariance (the truth within its 99.9% region) and map -> odom, the others apart. Bad bags
 // (missing topic, wrong type, truncated, unindexed) exit 2 with one line and write nothing. The
-// camera may come from the bag's camera_info instead of --camera.
+// camera may come from the bag's camera_info instead of --camera, and sit on a calibrated head
+// (--mount) whose angles are the bag's joint states.
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
@@ -21,8 +22,10 @@
 #include "app/ros/ros_geometry.h"
 #include "app/ros/ros_messages.h"
 #include "models/trajectory_io.h"
+#include "tests/app/calibrated_head.h"
 #include "tests/app/ros_test_scene.h"
 #include "tests/support/cli_test.h"
+#include "tracking/head/head_pointing.h"
 
 namespace linetrack::app {
 namespace {
@@ -46,13 +49,17 @@ constexpr double kRegion999Chi2Dof3 = 16.266;
 // robot's alert limit is set above them, so that most poses are tracking.
 constexpr const char* kAlertLimit = "0.3,2";
 
-// The run, written once for the suite.
+// A run written once for the suite: its frames rendered with the camera placed by
+// `place_camera` (RenderHallDrive's; null: the nominal mount at kSceneHeight on the pan axis).
 struct BagRun {
-  test::RenderedDrive drive = test::RenderHallDrive(kFrames, DegToRad(kPanAmplitudeDeg));
-  fs::path bag = fs::path(LINETRACK_BINARY_DIR) / "test_output" / "ros_bag_run.bag";
-  fs::path truth = fs::path(LINETRACK_BINARY_DIR) / "test_output" / "ros_bag_run_truth.txt";
+  test::RenderedDrive drive;
+  fs::path bag, truth;
 
-  BagRun() {
+  BagRun(const std::string& name,
+         const std::function<Eigen::Isometry3d(const SequenceFrame&)>& place_camera)
+      : drive(test::RenderHallDrive(kFrames, DegToRad(kPanAmplitudeDeg), place_camera)),
+        bag(fs::path(LINETRACK_BINARY_DIR) / "test_output" / (name + ".bag")),
+        truth(fs::path(LINETRACK_BINARY_DIR) / "test_output" / (name + "_truth.txt")) {
     fs::create_directories(bag.parent_path());
     rosbag::Bag out(bag.string(), rosbag::bagmode::Write);
     const Eigen::Isometry3d odom_from_map = PlanarIsometry(drive.frames[0].base.Planar()).inverse();
@@ -83,23 +90,35 @@ struct BagRun {
 };
 
 const BagRun& TheRun() {
-  static const BagRun run;
+  static const BagRun run("ros_bag_run", nullptr);
+  return run;
+}
+
+// The camera on test::CalibratedHead at the joint states' angles.
+const BagRun& TheMountRun() {
+  static const BagRun run("ros_bag_mount_run", [](const SequenceFrame& f) {
+    return CamFromWorldOnHead(test::CalibratedHead(), f.base.Planar(), test::kCrossingHeightM,
+                              f.pan, f.camera.tilt);
+  });
   return run;
 }
 
 class RosBagReplay : public test_support::CliTest {
  protected:
   // The replay of `bag`; the camera from --camera unless `camera` names another source.
+  // The camera on the head: --height (the nominal mount) unless `mount` is --mount's flag.
   std::string Args(const fs::path& bag, const std::string& odom_topic, const fs::path& out,
-                   const std::string& camera = "--camera " + kCameraFile) {
+                   const std::string& camera = "--camera " + kCameraFile,
+                   const std::string& mount = "") {
     const Pose3Dof start = TheRun().drive.frames[0].base.Planar();
+    const std::string head =
+        mount.empty() ? "--height " + std::to_string(test::kSceneHeight) : mount;
     return "replay --input " + bag.string() + " --image-topic /camera/image_raw --odom-topic " +
            odom_topic + " --joint-states-topic /joint_states --pan-joint head_pan --tilt-joint " +
-           "head_tilt --height " + std::to_string(test::kSceneHeight) + " --model " + kSource +
-           "/models/hall.cao " + camera + " --prior " + std::to_string(start.x) + "," +
-           std::to_string(start.y) + "," + std::to_string(RadToDeg(start.heading)) +
-           " --no-overlay --out " + out.string() + " --out-bag " + (out.string() + ".bag") +
-           " --alert-limit " + kAlertLimit;
+           "head_tilt " + head + " --model " + kSource + "/models/hall.cao " + camera +
+           " --prior " + std::to_string(start.x) + "," + std::to_string(start.y) + "," +
+           std::to_string(RadToDeg(start.heading)) + " --no-overlay --out " + out.string() +
+           " --out-bag " + (out.string() + ".bag") + " --alert-limit " + kAlertLimit;
   }
 
   void ExpectRejected(const fs::path& bag, const std::string& odom_topic, const std::string& named,
@@ -222,13 +241,48 @@ TEST_F(RosBagReplay, TheCameraFromTheBagsCameraInfo) {
   }
 }
 
+// The camera on a calibrated head (--mount, its floor height in place of --height) at the bag's
+// joint states: the output bag's base poses and the camera centres match the truth as with the
+// nominal mount. The nominal geometry would put the camera 76.5 mm and 1.2 degrees off.
+TEST_F(RosBagReplay, TheCameraOnACalibratedMountAtTheJointStates) {
+  const BagRun& run = TheMountRun();
+  const std::string mount =
+      test::WriteMountJson(test::CalibratedHead(), kCameraFile, dir_ / "head");
+  const fs::path out = dir_ / "replay_mount";
+  const test_support::CommandRun result =
+      Linetrack(Args(run.bag, "/robot/odom", out, "--camera " + kCameraFile, "--mount " + mount) +
+                " --ground-truth " + run.truth.string());
+  ASSERT_EQ(result.code, 0) << result.err;
+  const std::vector<StampedPose> poses = ReadTum((out / "poses.txt").string());
+  EXPECT_GE(static_cast<int>(poses.size()), kFrames - kMaxFramesNotTracking);
+  for (const StampedPose& pose : poses) {
+    const int i = static_cast<int>(std::lround((pose.t - test::kSceneStart) / test::kSceneStep));
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, kFrames);
+    const Eigen::Vector3d truth = run.drive.frames[i].cam_from_world.inverse().translation();
+    EXPECT_LT((pose.world_from_cam.translation() - truth).norm(), kPositionTolM) << "frame " << i;
+  }
+  const OutBagCounts n = CheckOutBag(out.string() + ".bag", run.drive);
+  EXPECT_EQ(n.tracking, static_cast<int>(poses.size()));
+  EXPECT_GT(n.tracking, 0);
+
+  // Without the joint states the head's angles are unknown: refused, naming what is missing.
+  const test_support::CommandRun no_joints = Linetrack(
+      "replay --input " + run.bag.string() + " --image-topic /camera/image_raw --odom-topic " +
+      "/robot/odom --mount " + mount + " --tilt 5 --model " + kSource + "/models/hall.cao " +
+      "--camera " + kCameraFile + " --prior 0,0,0 --no-overlay --out " + (dir_ / "nj").string());
+  EXPECT_EQ(no_joints.code, 2) << no_joints.err;
+  EXPECT_NE(no_joints.err.find("--joint-states-topic"), std::string::npos) << no_joints.err;
+  EXPECT_FALSE(fs::exists(dir_ / "nj"));
+}
+
 TEST_F(RosBagReplay, BadBagsExitTwoWithOneLineAndWriteNothing) {
   const BagRun& run = TheRun();
   ExpectRejected(run.bag, "/wheel/odom", "/wheel/odom");      // missing topic
   ExpectRejected(run.bag, "/joint_states", "/joint_states");  // wrong message type
   ExpectRejected(dir_ / "absent.bag", "/robot/odom", "absent.bag");
-  // A calibrated mount is not yet applied to a bag's joint states: refused, not ignored.
-  ExpectRejected(run.bag, "/robot/odom", "--mount", " --mount " + (dir_ / "mount.json").string());
+  ExpectRejected(run.bag, "/robot/odom", "mount.json",
+                 " --mount " + (dir_ / "mount.json").string());  // missing
 
   // Truncated: the first half of the file.
   const std::string bytes = test_support::ReadAll(run.bag);
