@@ -24,11 +24,29 @@ bool LocalizerOptions::Check(std::string* why) const {
     *why = "unsearched_branches_share: must be in [0, 1]";
     return false;
   }
+  if (!(budget_reference_edges > 0.0) || !(max_budget_scale >= 1.0 && max_budget_scale <= 100.0)) {
+    *why = "budget_reference_edges must be positive and max_budget_scale in [1, 100]";
+    return false;
+  }
   if (method == MatchMethod::kHypothesizeAndTest && !sampler) {
     *why = "method: hypothesise-and-test needs a sampler";
     return false;
   }
   return noise.Check(why) && tree.Check(why) && verification.Check(why);
+}
+
+LocalizerOptions BudgetsForCandidates(LocalizerOptions options, int candidate_edges) {
+  const double scale =
+      std::clamp(candidate_edges / options.budget_reference_edges, 1.0, options.max_budget_scale);
+  if (scale == 1.0) return options;
+  const auto scaled = [scale](auto budget) {
+    return static_cast<decltype(budget)>(std::round(scale * static_cast<double>(budget)));
+  };
+  options.tree.max_nodes = scaled(options.tree.max_nodes);
+  options.tree.max_checks = scaled(options.tree.max_checks);
+  options.tree.max_hypotheses = scaled(options.tree.max_hypotheses);
+  options.verification.max_pair_tests = scaled(options.verification.max_pair_tests);
+  return options;
 }
 
 void CheckProblem(const LocalizationProblem& p) {
@@ -469,7 +487,8 @@ LocalizationResult Localizer::Localize(const LocalizationProblem& problem) const
   context.roll = problem.roll;
   std::vector<VerifiedPose> verified;
   if (options_.method == MatchMethod::kInterpretationTree) {
-    verified = SearchTree(context, options_, &result);
+    verified =
+        SearchTree(context, BudgetsForCandidates(options_, static_cast<int>(ids.size())), &result);
   } else {
     verified = options_.sampler(context, prior, options_.verification, &result.samples);
     result.hypotheses = static_cast<int>(verified.size());

@@ -49,9 +49,19 @@ struct LocalizerOptions {
   // search's: depth first, the root's first branch can take the whole budget while its siblings
   // have the same bound.
   double unsearched_branches_share = 0.1;
+  // A query that keeps more candidate edges gets more of every budget above (nodes, checks,
+  // leaves, pair tests): x candidates / budget_reference_edges, between 1 and max_budget_scale.
+  // A fixed budget covers less of a larger search, and answers from an exhausted search are
+  // where wrong ones come from (docs/matching.md). 35 is the generated building's median query.
+  double budget_reference_edges = 35.0;
+  double max_budget_scale = 2.0;
 
   bool Check(std::string* why) const;
 };
+
+// `options` with its search budgets scaled for a query of `candidate_edges` edges
+// (LocalizerOptions::budget_reference_edges, max_budget_scale).
+LocalizerOptions BudgetsForCandidates(LocalizerOptions options, int candidate_edges);
 
 // One localisation problem: undistorted image segments (pixels) and the prior.
 struct LocalizationProblem {

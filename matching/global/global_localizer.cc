@@ -62,6 +62,7 @@ LocalizerOptions VerifierOptions(const LocalizerOptions& localizer, const Global
   out.tree.max_checks = scaled(out.tree.max_checks);
   out.tree.max_hypotheses = scaled(out.tree.max_hypotheses);
   out.verification.max_pair_tests = scaled(out.verification.max_pair_tests);
+  out.max_budget_scale = 1.0;  // the verifications' budgets are the global mode's own
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "matching/evaluation/diagnosis.h"
@@ -145,11 +146,11 @@ TEST_F(LocalizerTest, SameInputSameResult) {
 }
 
 TEST_F(LocalizerTest, TwoHundredClutterLinesStayWithinTheBudget) {
-  LocalizerOptions options;
-  const Localizer localizer(model_, &regions_, &area_, PaperSyntheticCamera(), options);
+  const Localizer localizer(model_, &regions_, &area_, PaperSyntheticCamera());
   for (const SyntheticScene& scene : Scenes(2, 13, 200)) {
     ASSERT_GE(scene.lines.size(), 200u);
     const LocalizationResult r = localizer.Localize(Problem(scene));
+    const LocalizerOptions options = BudgetsForCandidates({}, r.candidate_edges);
     // The main search and, when it ran out of budget, at most two searches of the lines its best
     // pose leaves unexplained, each with unexplained_search_share of the budgets.
     const double budgets = 1.0 + 2.0 * options.unexplained_search_share;
@@ -163,6 +164,53 @@ TEST_F(LocalizerTest, TwoHundredClutterLinesStayWithinTheBudget) {
       EXPECT_LE(std::hypot(r.pose.x - scene.truth.x, r.pose.y - scene.truth.y), kWrongPositionM);
     }
   }
+}
+
+// x candidates / 35, between 1 and 2, on every budget of the search.
+TEST(BudgetsForCandidatesTest, ScaleWithTheQueryBetweenOneAndTheCap) {
+  const LocalizerOptions base;
+  const auto nodes = [&](int candidates) {
+    return BudgetsForCandidates(base, candidates).tree.max_nodes;
+  };
+  EXPECT_EQ(nodes(20), base.tree.max_nodes);
+  EXPECT_EQ(nodes(35), base.tree.max_nodes);
+  EXPECT_EQ(nodes(49), static_cast<int>(std::round(1.4 * base.tree.max_nodes)));
+  EXPECT_EQ(nodes(70), 2 * base.tree.max_nodes);
+  EXPECT_EQ(nodes(700), 2 * base.tree.max_nodes);
+  const LocalizerOptions scaled = BudgetsForCandidates(base, 70);
+  EXPECT_EQ(scaled.tree.max_checks, 2 * base.tree.max_checks);
+  EXPECT_EQ(scaled.tree.max_hypotheses, 2 * base.tree.max_hypotheses);
+  EXPECT_EQ(scaled.verification.max_pair_tests, 2 * base.verification.max_pair_tests);
+  LocalizerOptions fixed;
+  fixed.max_budget_scale = 1.0;
+  EXPECT_EQ(BudgetsForCandidates(fixed, 700).tree.max_nodes, fixed.tree.max_nodes);
+  std::string why;
+  fixed.max_budget_scale = 0.5;
+  EXPECT_FALSE(fixed.Check(&why));
+  fixed.max_budget_scale = 2.0;
+  fixed.budget_reference_edges = 0.0;
+  EXPECT_FALSE(fixed.Check(&why));
+}
+
+// A wide prior's query keeps many candidate edges: its search runs on the scaled node budget,
+// the same search with the scale capped at 1 stops at the base budget.
+TEST_F(LocalizerTest, AQueryOfManyCandidatesSearchesWithALargerBudget) {
+  constexpr int kNodes = 40;
+  LocalizerOptions options;
+  options.tree.max_nodes = kNodes;
+  options.unexplained_search_share = 0.0;
+  options.unsearched_branches_share = 0.0;
+  LocalizerOptions fixed = options;
+  fixed.max_budget_scale = 1.0;
+  SyntheticScene scene;
+  const LocalizationResult scaled = LocalizeBenchmarkScene(3, 2.0, 45.0, 0, &scene, options);
+  const LocalizationResult base = LocalizeBenchmarkScene(3, 2.0, 45.0, 0, &scene, fixed);
+  ASSERT_GE(scaled.candidate_edges, 1.5 * options.budget_reference_edges);
+  EXPECT_TRUE(base.budget_exhausted);
+  EXPECT_LE(base.tree_nodes, kNodes);
+  EXPECT_GT(scaled.tree_nodes, kNodes);
+  EXPECT_LE(scaled.tree_nodes,
+            BudgetsForCandidates(options, scaled.candidate_edges).tree.max_nodes);
 }
 
 TEST_F(LocalizerTest, TheTruthPassesEveryStageOfTheDiagnosis) {
@@ -420,13 +468,17 @@ TEST_F(LocalizerTest, UnsearchedRootBranchesAreSearchedOnTheirOwn) {
 // them, the truth.
 TEST_F(LocalizerTest, TruthInAnUnsearchedRootBranchIsFound) {
   SyntheticScene scene;
-  LocalizerOptions without;
+  // The base budget, not the one scaled for this wide query's candidates (which finds the truth
+  // in the main search).
+  LocalizerOptions with;
+  with.max_budget_scale = 1.0;
+  LocalizerOptions without = with;
   without.unsearched_branches_share = 0.0;
   const LocalizationResult before = LocalizeBenchmarkScene(1, 2.0, 45.0, 307, &scene, without);
   ASSERT_TRUE(before.found) << before.reason;  // the scene exercises the mechanism
   EXPECT_GT(std::hypot(before.pose.x - scene.truth.x, before.pose.y - scene.truth.y),
             kWrongPositionM);
-  const LocalizationResult r = LocalizeBenchmarkScene(1, 2.0, 45.0, 307, &scene);
+  const LocalizationResult r = LocalizeBenchmarkScene(1, 2.0, 45.0, 307, &scene, with);
   ASSERT_TRUE(r.found) << r.reason;
   EXPECT_TRUE(r.budget_exhausted);
   EXPECT_LE(std::hypot(r.pose.x - scene.truth.x, r.pose.y - scene.truth.y), kWrongPositionM);
