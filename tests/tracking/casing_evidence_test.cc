@@ -76,6 +76,18 @@ TEST(CasingEvidence, FindsNoneBesideASharpJambWithoutABand) {
   EXPECT_EQ(found.with_ridge, 0);
 }
 
+TEST(CasingEvidence, AShortJambRulesNothingOutButReportsItsRidges) {
+  // Four points: too few to rule a casing out, the band's border still measured on each.
+  EdgeObservation jamb = Jamb();
+  jamb.points.resize(4);
+  const CasingEvidence found = FindCasing(
+      Render(true, 0.0), Camera(), Eigen::Isometry3d::Identity(), jamb, CasingEvidenceOptions());
+  EXPECT_EQ(found.verdict, CasingVerdict::kUnclear);
+  EXPECT_EQ(found.examined, 4);
+  EXPECT_EQ(found.with_ridge, 4);
+  EXPECT_NEAR(found.width_m, kCasingM, kWidthToleranceM);
+}
+
 TEST(CasingEvidence, ABlurredJambRulesNothingOut) {
   // 12 px of motion across the jamb: the band's border merges with the jamb's step.
   for (bool band : {false, true}) {

@@ -146,13 +146,13 @@ CasingEvidence FindCasing(const vpImage<unsigned char>& image, const CameraIntri
     widths.push_back(read.ridge_px / per_m);
     tolerances.push_back(options.width_tolerance_px / std::abs(per_m));
   }
+  const std::pair<int, double> common = CommonWidth(widths, tolerances);
+  out.with_ridge = common.first;
+  out.width_m = common.second;
   const int points = static_cast<int>(edge.points.size());
   if (out.examined < options.min_points || out.examined < options.min_examined_share * points) {
     return out;
   }
-  const std::pair<int, double> common = CommonWidth(widths, tolerances);
-  out.with_ridge = common.first;
-  out.width_m = common.second;
   out.verdict = out.with_ridge >= options.min_ridge_share * out.examined ? CasingVerdict::kSeen
                                                                          : CasingVerdict::kAbsent;
   return out;

@@ -48,7 +48,7 @@ struct CasingEvidence {
   CasingVerdict verdict = CasingVerdict::kUnclear;
   int examined = 0;      // points whose profile was examined
   int with_ridge = 0;    // of those, points with a second ridge at the most common width
-  double width_m = 0.0;  // that width (signed along edge.casing_direction), when seen
+  double width_m = 0.0;  // that width (signed along edge.casing_direction), when any
 };
 
 // Looks for the casing of `edge` (its points and casing_direction, world) in the undistorted
