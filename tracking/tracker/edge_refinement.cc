@@ -8,6 +8,7 @@
 
 #include "models/occlusion.h"
 #include "models/robot_pose.h"
+#include "tracking/tracker/image_sampling.h"
 
 namespace linetrack {
 
@@ -19,20 +20,6 @@ constexpr double kJacobianStep = 1e-6;
 // The edge profile extends this far beyond the search window on each side, so that the flanks of
 // a blurred step whose peak lies near the window's end are inside it (pixels).
 constexpr double kProfileMarginPx = 1.0;
-
-// Bilinear interpolation; false outside the image.
-bool Bilinear(const vpImage<unsigned char>& image, const Eigen::Vector2d& p, double* value) {
-  const double u = p.x(), v = p.y();
-  if (!(u >= 0.0 && v >= 0.0 && u < image.getWidth() - 1.0 && v < image.getHeight() - 1.0)) {
-    return false;
-  }
-  const unsigned u0 = static_cast<unsigned>(u), v0 = static_cast<unsigned>(v);
-  const double fu = u - u0, fv = v - v0;
-  const double top = (1.0 - fu) * image[v0][u0] + fu * image[v0][u0 + 1];
-  const double bottom = (1.0 - fu) * image[v0 + 1][u0] + fu * image[v0 + 1][u0 + 1];
-  *value = (1.0 - fv) * top + fv * bottom;
-  return true;
-}
 
 // A model edge as seen from the start pose (its 3D part inside the view, clipped to the frustum)
 // and the sub-pixel edge points attached to it.
@@ -305,7 +292,8 @@ double SubpixelEdgeOffset(const vpImage<unsigned char>& image, const Eigen::Vect
     double sum = 0.0;
     for (int s = -1; s <= 1; ++s) {
       double value = 0.0;
-      if (!Bilinear(image, point + k * kSampleStep * normal + s * tangent, &value)) return nan;
+      if (!SampleBilinear(image, point + k * kSampleStep * normal + s * tangent, &value))
+        return nan;
       sum += value;
     }
     profile[k + half] = sum / 3.0;

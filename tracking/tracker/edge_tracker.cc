@@ -24,6 +24,7 @@
 #include "models/geometry.h"
 #include "models/text_format.h"
 #include "models/wireframe.h"
+#include "tracking/tracker/casing_evidence.h"
 
 namespace linetrack {
 
@@ -299,6 +300,9 @@ EdgeTrackResult EdgeTracker::Measure(const vpImage<unsigned char>& image, bool w
         if (o.model_edge >= 0 && o.model_edge < static_cast<int>(casing_directions_.size()))
           o.casing_direction = casing_directions_[o.model_edge];
       }
+      // A frame line pays the casing allowance unless the image shows it has no casing.
+      ClearCasingsNotSeen(image, camera_, result.cam_from_world, CasingEvidenceOptions(),
+                          &result.observations);
       result.set_aside = std::move(refined.set_aside);
     }
   }
