@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kStepPx = 0.5;     // between samples of a profile
 constexpr double kShiftM = 0.01;    // the edge's test shift across itself (metres)
-constexpr double kNearClip = 0.05;  // metres
+constexpr double kCasingNearClipM = 0.05;  // metres
 
 // The image line through the projections of a and b: a point and the unit normal (-d_y, d_x).
 struct ImageLine {
@@ -23,7 +23,7 @@ struct ImageLine {
 bool Project(const CameraIntrinsics& camera, const Eigen::Isometry3d& pose,
              const Eigen::Vector3d& a, const Eigen::Vector3d& b, ImageLine* line) {
   const Eigen::Vector3d ca = pose * a, cb = pose * b;
-  if (ca.z() <= kNearClip || cb.z() <= kNearClip) return false;
+  if (ca.z() <= kCasingNearClipM || cb.z() <= kCasingNearClipM) return false;
   const Eigen::Vector2d pa = camera.Project(ca), pb = camera.Project(cb);
   const Eigen::Vector2d d = pb - pa;
   if (!(d.norm() > 1e-9)) return false;
