@@ -420,8 +420,7 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
       // The frame may disagree with the prior only when the matcher finds nothing around it; a
       // pose found there that the edges do not hold says the prior still fits.
       if (attempt.found) {
-        carry_frames_ = 0;
-        carry_seen_.reset();
+        // Reset once the pose is checked for a rival (HasRival counts the frames before it).
       } else if (attempt.lines >= options_.global.kidnap_min_lines) {
         ProbeCarry(*robot, prior.Planar());
         if (global_) MaybeSwitchToGlobal(*robot);
@@ -431,7 +430,14 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
       if (!attempt.found) {
         report->note = attempt.reason;
       } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
-        return HasRival(attempt.cam_from_world, *robot, report) ? nullptr : "matcher";
+        const bool rival = HasRival(attempt.cam_from_world, *robot, report);
+        carry_frames_ = 0;
+        carry_seen_.reset();
+        return rival ? nullptr : "matcher";
+      }
+      if (attempt.found) {
+        carry_frames_ = 0;
+        carry_seen_.reset();
       }
     } else {
       report->note = "no prior for the matcher";

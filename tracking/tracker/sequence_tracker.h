@@ -218,7 +218,8 @@ class SequenceTracker {
   // the jump with it.
   void RetestHypothesis(const RobotReading& robot);
   // Whether `pose` lies within the matcher's bounds around the pose the global mode left, carried
-  // to `robot`'s reading (HypothesisBounds): that pose then bounds it as a last good pose would.
+  // to `robot`'s reading (HypothesisBounds), that pose a confirmed one: it then bounds `pose` as a
+  // last good pose would.
   bool AgreesWithGlobalBefore(const Eigen::Isometry3d& pose, const RobotReading& robot) const;
   // Counts one frame that refutes the pose the global mode left; true when it is dropped.
   bool RefuteHypothesis();
@@ -301,6 +302,9 @@ class SequenceTracker {
   // carries it may be the truth, and a global answer away from it carries the jump in its
   // covariance until confirmed by driving (ReacquisitionCheck::confirm_distance_m).
   std::optional<GoodPose> global_before_;
+  // global_before_ was a confirmed pose (not a re-localisation under confirmation, not the
+  // matcher's pose the rival check withheld): only then does it bound a pose that agrees with it.
+  bool global_before_confirmed_ = false;
   std::optional<Reacquisition> reacquisition_;
   std::optional<Pose3Dof> last_odometry_;
   std::optional<CoastAnchor> anchor_;  // the last reported pose with finite levels

@@ -26,7 +26,10 @@ SearchBounds HypothesisBounds(const RelocalizationOptions& relocalization,
 void SequenceTracker::EnterGlobalMode(const std::string& why) {
   following_ = false;
   // An unconfirmed global pose is no hypothesis: the one its confirmation is held against stays.
-  if (last_good_ && !(reacquisition_ && reacquisition_->global)) global_before_ = last_good_;
+  if (last_good_ && !(reacquisition_ && reacquisition_->global)) {
+    global_before_ = last_good_;
+    global_before_confirmed_ = !reacquisition_;
+  }
   last_good_.reset();
   reacquisition_.reset();
   recent_projection_errors_.clear();
@@ -52,7 +55,11 @@ bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading
   if (!global_ || !o.check_relocalisations || !ever_good_) return false;
   const GlobalAttempt g = global_->Attempt(*undistorted_, robot.height, robot.tilt);
   std::string rival;
-  if (g.ambiguous) {
+  if (carry_frames_ > 0) {
+    // A frame since the last good pose showed the robot elsewhere: the view near the prior may
+    // be the twin of where the robot was carried (the office's corridors).
+    rival = std::to_string(carry_frames_) + " frames before showed the robot elsewhere";
+  } else if (g.ambiguous) {
     rival = "the global mode finds the view ambiguous (" + std::to_string(g.rivals) + " rivals)";
   } else if (g.found) {
     const Eigen::Vector2d d = PlanarDifference(PlanarOf(g.cam_from_world), PlanarOf(pose));
@@ -70,7 +77,10 @@ bool SequenceTracker::HasRival(const Eigen::Isometry3d& pose, const RobotReading
   report->cam_from_world.reset();
   report->source = "global";
   report->note = "global mode (" + global_reason_ + ")";
-  if (!keep) global_before_ = matcher;
+  if (!keep) {
+    global_before_ = matcher;
+    global_before_confirmed_ = false;
+  }
   return true;
 }
 
@@ -251,7 +261,7 @@ bool SequenceTracker::SearchAroundHypothesis(const Eigen::Isometry3d& hypothesis
 bool SequenceTracker::AgreesWithGlobalBefore(const Eigen::Isometry3d& pose,
                                              const RobotReading& robot) const {
   const std::optional<Eigen::Isometry3d> before = CarriedGlobalBefore(robot);
-  if (!before || !relocalizer_) return false;
+  if (!before || !relocalizer_ || !global_before_confirmed_) return false;
   const SearchBounds bounds = HypothesisBounds(relocalizer_->options(), options_.reacquisition,
                                                driven_m_ - global_before_->driven_m);
   const Eigen::Vector2d d = PlanarDifference(PlanarOf(pose), PlanarOf(*before));
