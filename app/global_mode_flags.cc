@@ -33,8 +33,8 @@ GlobalRecoveryOptions GlobalModeFlags::Options() const {
 void AddGlobalModeFlags(CLI::App* cmd, GlobalModeFlags* flags) {
   cmd->add_option("--kidnap-after-s", flags->kidnap_after_s,
                   "Global mode (the robot may have been carried away) after this many seconds of "
-                  "frames in a row whose lines the matcher around the odometry's prior cannot "
-                  "explain; frames counted from their stamps (0: off)")
+                  "frames (at least 2) that the matcher cannot place around the odometry's prior "
+                  "and the global mode places elsewhere; frames counted from their stamps (0: off)")
       ->capture_default_str();
   cmd->add_option("--global-after-s", flags->global_after_s,
                   "Global mode after this many seconds lost (0: off)")

@@ -29,6 +29,12 @@ constexpr double kNearDeg = 2.0;
 constexpr double kGlobalPoseM = 0.03;  // the global mode's verified pose against the truth
 constexpr double kGlobalPoseDeg = 0.5;
 constexpr int kConfirmFrames = 5;  // ReacquisitionCheck::confirm_frames
+// The drive without a carry: frames blurred (optical blur, pixels), then covered, from the frame
+// of the carry; the pose found again within the frames of issue 14's recovery target.
+constexpr double kBlurSigmaPx = 4.0;
+constexpr int kBlurredFrames = 4;
+constexpr int kCoveredFrames = 6;
+constexpr int kMaxFramesToRecover = 5;
 
 const std::string kSource = LINETRACK_SOURCE_DIR;
 
@@ -48,14 +54,15 @@ struct KidnapDrive {
     return nav;
   }
 
-  KidnapDrive() {
+  // With `carried` false the robot drives on where it is (the same odometry).
+  explicit KidnapDrive(bool carried = true) {
     DriveOptions drive;
     drive.tilt = DegToRad(5.0);
     std::vector<SequenceFrame> lap = DriveAlongLoop(LoopInsideArea(area), drive);
     const Pose3Dof put_down = lap[kKidnapFrame + lap.size() / 2].base.Planar();
     lap.resize(kFrames);
     priors = SimulateOdometryPriors(lap, OdometryOptions());
-    frames = ApplyKidnaps(lap, {{kKidnapFrame, put_down}}, &area);
+    frames = carried ? ApplyKidnaps(lap, {{kKidnapFrame, put_down}}, &area) : lap;
     RenderOptions render;
     render.scene.clutter = 10;
     SceneRenderer renderer(model, camera, render, &area);
@@ -187,6 +194,39 @@ TEST(KidnappedRobot, WithoutTheGlobalModeTheRobotIsNotFoundAgain) {
   ExpectNoWrongTrackingPose(reports, Drive());
 }
 
+// No carry: a stretch of blurred frames, then the lens covered, where the kidnapped drive is
+// carried. Frames the matcher cannot place are no evidence of a carry: the engine does not switch
+// to the global mode for one, and finds the pose again soon after the view returns, with no wrong
+// `tracking` pose.
+TEST(KidnappedRobot, BlurredAndCoveredFramesAreNoCarry) {
+  KidnapDrive d(/*carried=*/false);
+  RenderOptions blurred;
+  blurred.scene.clutter = 10;
+  blurred.blur_sigma = kBlurSigmaPx;
+  SceneRenderer renderer(d.model, d.camera, blurred, &d.area);
+  for (int i = kKidnapFrame; i < kKidnapFrame + kBlurredFrames; ++i)
+    d.images[i] = renderer.Render(d.frames[i].cam_from_world, i);
+  const int first_seen = kKidnapFrame + kBlurredFrames + kCoveredFrames;
+  for (int i = kKidnapFrame + kBlurredFrames; i < first_seen; ++i)
+    d.images[i] = vpImage<unsigned char>(d.images[i].getHeight(), d.images[i].getWidth(), 0);
+  const std::vector<FrameReport> reports = Replay(d, EngineOptions());
+  int recovered = -1;
+  std::string trace;
+  for (int i = kKidnapFrame; i < kFrames; ++i) {
+    const FrameReport& r = reports[i];
+    const std::string why = r.note + " " + r.uncertainty.reason;
+    trace +=
+        "\nframe " + std::to_string(i) + ": " + ToString(r.status) + ", " + r.source + ", " + why;
+    EXPECT_EQ(why.find("carried away"), std::string::npos) << "frame " << i << ": " << why;
+    if (recovered >= 0 || i < first_seen || !r.cam_from_world || r.source == "odometry") continue;
+    const PoseDifference e = ComparePoses(*r.cam_from_world, d.frames[i].cam_from_world);
+    if (e.translation <= kNearM && RadToDeg(e.rotation) <= kNearDeg) recovered = i;
+  }
+  ASSERT_GE(recovered, first_seen) << "never found again" << trace;
+  EXPECT_LE(recovered - first_seen, kMaxFramesToRecover) << trace;
+  ExpectNoWrongTrackingPose(reports, d);
+}
+
 TEST(GlobalModeReason, EachTriggerAndItsThreshold) {
   GlobalRecoveryOptions o;
   o.kidnap_s = 0.3;
@@ -198,12 +238,12 @@ TEST(GlobalModeReason, EachTriggerAndItsThreshold) {
   s.has_prior = true;
   s.frame_period_s = 0.1;  // 10 frames/s
   s.frames_since_good = 2;
-  s.failed_searches = 2;
+  s.carry_frames = 2;
   s.driven_since_m = 0.2;
   EXPECT_EQ(GlobalModeReason(s, o), "");
-  s.failed_searches = 3;
+  s.carry_frames = 3;
   EXPECT_NE(GlobalModeReason(s, o).find("carried away: 3 frames"), std::string::npos);
-  s.failed_searches = 0;
+  s.carry_frames = 0;
   s.frames_since_good = 25;
   EXPECT_EQ(GlobalModeReason(s, o), "lost 25 frames (2.5 s)");
   s.frames_since_good = 24;
@@ -232,13 +272,47 @@ TEST(GlobalModeReason, TheTimesBecomeFramesAtTheFramesRate) {
   GlobalRecoveryOptions o;
   LossState s;
   s.has_prior = true;
-  s.failed_searches = 3;
+  s.carry_frames = 3;
   s.frame_period_s = 1.0 / 30.0;
   EXPECT_EQ(GlobalModeReason(s, o), "") << "3 frames at 30 frames/s are 0.1 s";
-  s.failed_searches = 9;
+  s.carry_frames = 9;
   EXPECT_NE(GlobalModeReason(s, o).find("carried away"), std::string::npos);
   s.frame_period_s = 0.0;
   EXPECT_EQ(GlobalModeReason(s, o), "");
+  // A slow camera: 0.3 s is one frame, but one frame never shows a carry on its own.
+  s.frame_period_s = 1.0;
+  s.carry_frames = 1;
+  EXPECT_EQ(CarryFrames(o, 1.0), 2);
+  EXPECT_EQ(GlobalModeReason(s, o), "");
+  s.carry_frames = 2;
+  EXPECT_NE(GlobalModeReason(s, o).find("carried away"), std::string::npos);
+  o.kidnap_s = 0.0;  // off
+  EXPECT_EQ(CarryFrames(o, 1.0), 0);
+}
+
+// What counts as a frame showing the robot elsewhere: a global pose beyond the rival distance or
+// heading from the prior, or an ambiguous view with no rival near it; nothing found says nothing.
+TEST(ShowsElsewhere, AFoundPoseOrRivalsAwayFromThePrior) {
+  GlobalRecoveryOptions o;  // 0.5 m, 10 deg
+  const Pose3Dof prior{2.0, 3.0, DegToRad(90.0)};
+  GlobalAttempt a;
+  EXPECT_FALSE(ShowsElsewhere(a, prior, o)) << "no answer";
+  a.found = true;
+  a.planar = {2.3, 3.2, DegToRad(95.0)};  // 0.36 m, 5 deg: the prior's place
+  EXPECT_FALSE(ShowsElsewhere(a, prior, o));
+  a.planar = {2.0, 3.6, DegToRad(90.0)};  // 0.6 m
+  EXPECT_TRUE(ShowsElsewhere(a, prior, o));
+  a.planar = {2.0, 3.0, DegToRad(-89.0)};  // the mirror heading, in place
+  EXPECT_TRUE(ShowsElsewhere(a, prior, o));
+  a.planar = {2.0, 3.0, DegToRad(449.0)};  // 89 deg once wrapped: 1 deg off
+  EXPECT_FALSE(ShowsElsewhere(a, prior, o));
+  GlobalAttempt ambiguous;
+  ambiguous.ambiguous = true;
+  ambiguous.rival_poses = {{13.8, 3.0, DegToRad(90.0)}, {2.1, 3.1, DegToRad(92.0)}};
+  EXPECT_FALSE(ShowsElsewhere(ambiguous, prior, o)) << "a rival is at the prior";
+  ambiguous.rival_poses.pop_back();
+  ambiguous.rival_poses.push_back({-9.8, 3.0, DegToRad(90.0)});
+  EXPECT_TRUE(ShowsElsewhere(ambiguous, prior, o));
 }
 
 }  // namespace

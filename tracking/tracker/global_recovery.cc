@@ -11,8 +11,10 @@
 namespace linetrack {
 
 bool GlobalRecoveryOptions::Check(std::string* why) const {
-  if (!(kidnap_s >= 0.0) || !(lost_s >= 0.0) || kidnap_min_lines < 0) {
-    *why = "global mode: the seconds before the switch and the lines must be >= 0 (0: off)";
+  if (!(kidnap_s >= 0.0) || !(lost_s >= 0.0) || kidnap_min_lines < 0 || kidnap_min_frames < 1) {
+    *why =
+        "global mode: the seconds before the switch and the lines must be >= 0 (0: off), the "
+        "frames of a carry >= 1";
     return false;
   }
   if (!(rival_distance_m > 0.0) || !(rival_heading_deg > 0.0)) {
@@ -32,13 +34,31 @@ int FramesIn(double seconds, double period_s) {
   return std::max(1, static_cast<int>(std::ceil(seconds / period_s - 1e-6)));
 }
 
+int CarryFrames(const GlobalRecoveryOptions& options, double period_s) {
+  const int frames = FramesIn(options.kidnap_s, period_s);
+  return frames > 0 ? std::max(frames, options.kidnap_min_frames) : 0;
+}
+
+bool ShowsElsewhere(const GlobalAttempt& attempt, const Pose3Dof& prior,
+                    const GlobalRecoveryOptions& options) {
+  const auto away = [&](const Pose3Dof& pose) {
+    const double heading = std::abs(std::remainder(pose.heading - prior.heading, 2.0 * kPi));
+    return std::hypot(pose.x - prior.x, pose.y - prior.y) > options.rival_distance_m ||
+           heading > DegToRad(options.rival_heading_deg);
+  };
+  if (attempt.found) return away(attempt.planar);
+  if (!attempt.ambiguous) return false;
+  // An ambiguous view refutes the prior only when none of its rivals lies near it.
+  return std::all_of(attempt.rival_poses.begin(), attempt.rival_poses.end(), away);
+}
+
 std::string GlobalModeReason(const LossState& s, const GlobalRecoveryOptions& o) {
   if (!s.has_prior) return "no prior";
   const bool odometry = s.driven_since_m >= 0.0;
-  const int kidnap_frames = FramesIn(o.kidnap_s, s.frame_period_s);
-  if (kidnap_frames > 0 && s.failed_searches >= kidnap_frames) {
-    return "carried away: " + std::to_string(s.failed_searches) + " frames with lines (" +
-           Fixed(s.failed_searches * s.frame_period_s, 1) + " s) disagree with the carried prior";
+  const int kidnap_frames = CarryFrames(o, s.frame_period_s);
+  if (kidnap_frames > 0 && s.carry_frames >= kidnap_frames) {
+    return "carried away: " + std::to_string(s.carry_frames) +
+           " frames show the robot away from the carried prior";
   }
   const int lost_frames = FramesIn(o.lost_s, s.frame_period_s);
   if (lost_frames > 0 && s.frames_since_good >= lost_frames) {
@@ -75,9 +95,11 @@ GlobalAttempt GlobalRecovery::Attempt(const vpImage<unsigned char>& undistorted,
   attempt.ms = MillisecondsSince(start);
   attempt.ambiguous = result.ambiguous;
   attempt.rivals = static_cast<int>(result.rivals.size());
+  attempt.rival_poses = result.rivals;
   if (result.found && !result.ambiguous) {
     attempt.found = true;
     attempt.cam_from_world = result.best.cam_from_world;
+    attempt.planar = RobotPoseFromCamFromWorld(attempt.cam_from_world).Planar();
   } else {
     attempt.reason = "global: " + result.reason;
   }

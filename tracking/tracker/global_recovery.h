@@ -13,6 +13,7 @@
 
 #include "matching/global/global_localizer.h"
 #include "matching/lines/line_extractor.h"
+#include "models/robot_pose.h"
 
 namespace linetrack {
 
@@ -22,12 +23,15 @@ namespace linetrack {
 struct GlobalRecoveryOptions {
   // The engine builds the global mode (for these triggers and SequenceTracker::RequestGlobal).
   bool enabled = true;
-  // Matcher searches in a row around the carried prior found no consistent hypothesis on the
-  // frames of kidnap_s seconds that show at least kidnap_min_lines segments: the view disagrees
-  // with the prior, the robot may have been carried away (the odometry does not see a carry).
-  // A blank frame leaves the count as it is; a pose found near the prior resets it.
+  // The robot was carried away (the odometry does not see a carry) when the frames of kidnap_s
+  // seconds, and at least kidnap_min_frames, show it elsewhere: on each, the matcher around the
+  // carried prior finds nothing among at least kidnap_min_lines segments, and the global mode
+  // finds a pose away from that prior or an ambiguous view with no rival near it
+  // (ShowsElsewhere), the poses found agreeing with each other. A frame neither places (blurred,
+  // blank) leaves the count as it is; a pose found near the prior resets it.
   double kidnap_s = 0.3;
   int kidnap_min_lines = 8;
+  int kidnap_min_frames = 2;
   // Lost for lost_s seconds (the relocaliser's widening bounds reach their limit after 24 frames
   // of 0.1 s by default) or lost_distance_m metres driven since the last good pose.
   double lost_s = 2.5;
@@ -51,10 +55,14 @@ int FramesIn(double seconds, double period_s);
 struct LossState {
   bool has_prior = false;        // there is a prior for the matcher (a good pose, odometry, ...)
   int frames_since_good = 0;     // frames since the last good pose
-  int failed_searches = 0;       // matcher searches in a row that found nothing, frames with lines
+  int carry_frames = 0;          // frames that showed the robot away from the prior (kidnap_s)
   double driven_since_m = -1.0;  // odometry distance since the last good pose; < 0: no odometry
   double frame_period_s = 0.0;   // the frames' interval from their stamps; <= 0: not known yet
 };
+
+// The frames that show a carry (kidnap_s, at least kidnap_min_frames) at one frame every
+// `period_s` seconds; 0 when the trigger is off or the period not known yet.
+int CarryFrames(const GlobalRecoveryOptions& options, double period_s);
 
 // Why this frame needs the global mode (pure), or empty when the local matcher keeps searching.
 std::string GlobalModeReason(const LossState& state, const GlobalRecoveryOptions& options);
@@ -64,11 +72,19 @@ struct GlobalAttempt {
   bool found = false;      // one pose, not ambiguous
   bool ambiguous = false;  // rival poses explain the image equally well: none is used
   int rivals = 0;
+  std::vector<Pose3Dof> rival_poses;  // when ambiguous (x, y metres, heading radians)
   Eigen::Isometry3d cam_from_world = Eigen::Isometry3d::Identity();  // when found
+  Pose3Dof planar;                                                   // its x, y, heading
   int lines = 0;                                                     // segments extracted
   double ms = 0.0;
   std::string reason;  // why no pose
 };
+
+// Whether the global mode's answer shows the robot away from `prior`: a pose found beyond
+// options.rival_distance_m or rival_heading_deg from it, or an ambiguous view none of whose
+// rivals lies within those.
+bool ShowsElsewhere(const GlobalAttempt& attempt, const Pose3Dof& prior,
+                    const GlobalRecoveryOptions& options);
 
 class GlobalRecovery {
  public:

@@ -152,7 +152,8 @@ void SequenceTracker::Accept(const EdgeTrackResult& result, double t,
                              FrameReport* report) {
   following_ = true;
   ever_good_ = true;
-  failed_searches_ = 0;
+  carry_frames_ = 0;
+  carry_seen_.reset();
   last_good_ = GoodPose{result.cam_from_world, t, robot, driven_m_};
   recent_projection_errors_.push_back(result.health.projection_error_deg);
   while (recent_projection_errors_.size() > static_cast<size_t>(options_.jump_window))
@@ -393,6 +394,7 @@ void SequenceTracker::Follow(double t, const std::optional<RobotReading>& robot,
   Accept(result, t, robot, "tracker", report);
   report->status = TrackStatus::kTracking;
   Assess(result.observations, robot, report);
+  if (robot) RetestHypothesis(*robot);
   if (reacquisition_ && !CheckReacquisition(robot, nullptr, report)) Drop(report->note, report);
 }
 
@@ -415,18 +417,27 @@ const char* SequenceTracker::Search(double t, const std::optional<RobotReading>&
     if (MatcherPrior(*robot, &prior, &bounds)) {
       const RelocalizationAttempt attempt = relocalizer_->Attempt(*undistorted_, prior, bounds);
       report->lines = attempt.lines;
-      // The frame disagrees with the prior only when the matcher finds nothing around it; a pose
-      // found there that the edges do not hold says the prior still fits.
+      // The frame may disagree with the prior only when the matcher finds nothing around it; a
+      // pose found there that the edges do not hold says the prior still fits.
       if (attempt.found) {
-        failed_searches_ = 0;
+        // Reset once the pose is checked for a rival (HasRival counts the frames before it).
       } else if (attempt.lines >= options_.global.kidnap_min_lines) {
-        ++failed_searches_;
+        ProbeCarry(*robot, prior.Planar());
+        if (global_) MaybeSwitchToGlobal(*robot);
+        if (global_mode_) return TryGlobal(t, *robot, report) ? "global" : nullptr;
       }
       image_allows_coasting_ = attempt.found || attempt.lines < options_.global.kidnap_min_lines;
       if (!attempt.found) {
         report->note = attempt.reason;
       } else if (StartAndVerify(attempt.cam_from_world, t, robot, report)) {
-        return HasRival(attempt.cam_from_world, *robot, report) ? nullptr : "matcher";
+        const bool rival = HasRival(attempt.cam_from_world, *robot, report);
+        carry_frames_ = 0;
+        carry_seen_.reset();
+        return rival ? nullptr : "matcher";
+      }
+      if (attempt.found) {
+        carry_frames_ = 0;
+        carry_seen_.reset();
       }
     } else {
       report->note = "no prior for the matcher";
@@ -475,12 +486,15 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
   }
   FrameReport report;
   image_allows_coasting_ = false;
+  image_refutes_coasting_ = false;
+  probe_.reset();
   undistorted_ = &undistorter_.Apply(image);
   report.undistort_ms = MillisecondsSince(start);
 
   const std::optional<CoastedPose> coasted = CoastToFrame(robot);
   if (following_) {
     Follow(t, robot, &report);
+    if (report.status == TrackStatus::kLost && coasted && robot) CheckCoasted(*robot, *coasted);
     WithholdUnconfirmedGlobal(&report);
     Combine(robot, coasted, &report);
     report.total_ms = MillisecondsSince(start);
@@ -504,9 +518,17 @@ FrameReport SequenceTracker::Process(const vpImage<unsigned char>& image, double
     report.status = had_pose ? TrackStatus::kRelocalised : TrackStatus::kTracking;
     if (had_pose) ++recoveries_;
     Assess(verified_observations_, robot, &report);
-    // A global pose has no pose before it: its check starts afresh, against nothing.
+    // A global pose has no pose before it: its check starts afresh, against nothing; unless it
+    // (or a pose found with no good pose before it) agrees with the pose the global mode left,
+    // carried by the odometry, which then bounds it as a last good pose bounds a re-localisation.
     const bool global = std::string(source) == "global";
-    if (global) before.reset();
+    if ((global || !before) && robot && report.cam_from_world &&
+        AgreesWithGlobalBefore(pose, *robot)) {
+      before = global_before_;
+      global_mode_ = false;
+    } else if (global) {
+      before.reset();
+    }
     const bool matcher = global || std::string(source) == "matcher";
     if (global && !report.cam_from_world) {
       // The integrity monitor finds the global pose lost: nothing to confirm, search again.

@@ -199,9 +199,31 @@ class SequenceTracker {
   // (GlobalRecoveryOptions::check_relocalisations): true (and the global mode entered) when it
   // has a rival elsewhere or is ambiguous.
   bool HasRival(const Eigen::Isometry3d& pose, const RobotReading& robot, FrameReport* report);
-  // Localises the frame with the global mode and verifies its pose; false when none. A pose away
-  // from the one the global mode left is checked against the image (HypothesisHolds).
+  // Localises the frame with the global mode (this frame's probe_ when there is one) and verifies
+  // its pose; false when none. A pose away from the one the global mode left is checked against
+  // the image (HypothesisHolds).
   bool TryGlobal(double t, const RobotReading& robot, FrameReport* report);
+  // In the global mode with no rival on the frame: the matcher around `hypothesis` (the pose the
+  // mode left, carried `driven_m` metres), then a restart from it within the restart window.
+  bool SearchAroundHypothesis(const Eigen::Isometry3d& hypothesis, double driven_m, double t,
+                              const RobotReading& robot, FrameReport* report);
+  // The image's evidence of a carry on a frame whose matcher found nothing around `prior` among
+  // enough lines: the global mode's answer (ShowsElsewhere) counted into carry_frames_.
+  void ProbeCarry(const RobotReading& robot, const Pose3Dof& prior);
+  // On a frame the tracker lost, with a coasted pose: whether the image allows it (the matcher
+  // finds a pose around it, or too few lines to say) or refutes it (ProbeCarry).
+  void CheckCoasted(const RobotReading& robot, const CoastedPose& coasted);
+  // On a frame tracking a global pose held against the pose the global mode left (a jump): the
+  // matcher around that pose, carried; refuted on RefutationsNeeded() frames, it is dropped and
+  // the jump with it.
+  void RetestHypothesis(const RobotReading& robot);
+  // Whether `pose` lies within the matcher's bounds around the pose the global mode left, carried
+  // to `robot`'s reading (HypothesisBounds), that pose a confirmed one: it then bounds `pose` as a
+  // last good pose would.
+  bool AgreesWithGlobalBefore(const Eigen::Isometry3d& pose, const RobotReading& robot) const;
+  // Counts one frame that refutes the pose the global mode left; true when it is dropped.
+  bool RefuteHypothesis();
+  int RefutationsNeeded() const;
   // Where the odometry carries the pose the global mode left (global_before_) to `robot`'s
   // reading; none without it or without odometry at both readings.
   std::optional<Eigen::Isometry3d> CarriedGlobalBefore(const RobotReading& robot) const;
@@ -280,6 +302,9 @@ class SequenceTracker {
   // carries it may be the truth, and a global answer away from it carries the jump in its
   // covariance until confirmed by driving (ReacquisitionCheck::confirm_distance_m).
   std::optional<GoodPose> global_before_;
+  // global_before_ was a confirmed pose (not a re-localisation under confirmation, not the
+  // matcher's pose the rival check withheld): only then does it bound a pose that agrees with it.
+  bool global_before_confirmed_ = false;
   std::optional<Reacquisition> reacquisition_;
   std::optional<Pose3Dof> last_odometry_;
   std::optional<CoastAnchor> anchor_;  // the last reported pose with finite levels
@@ -292,10 +317,15 @@ class SequenceTracker {
   bool global_mode_ = false;               // lost frames are localised by the global mode
   // This frame's matcher found a pose around the prior, or saw too few lines to contradict it.
   bool image_allows_coasting_ = false;
-  int failed_searches_ = 0;    // matcher searches in a row finding nothing (GlobalRecoveryOptions)
-  std::string global_reason_;  // why the global mode was entered
-  long frame_index_ = -1;      // frames processed - 1
-  double t_ = 0.0;             // this frame's stamp (seconds)
+  // This frame shows the robot away from the pose the odometry carries (ProbeCarry).
+  bool image_refutes_coasting_ = false;
+  std::optional<GlobalAttempt> probe_;  // this frame's global answer (ProbeCarry)
+  int carry_frames_ = 0;  // frames showing the robot elsewhere (GlobalRecoveryOptions)
+  std::optional<GoodPose> carry_seen_;   // the last pose they found
+  int hypothesis_refutations_ = 0;       // frames in a row refuting global_before_
+  std::string global_reason_;            // why the global mode was entered
+  long frame_index_ = -1;                // frames processed - 1
+  double t_ = 0.0;                       // this frame's stamp (seconds)
   std::deque<double> recent_intervals_;  // the last stamps' differences (seconds)
   long last_good_index_ = -1;
   int losses_ = 0;
