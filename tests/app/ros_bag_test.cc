@@ -223,6 +223,20 @@ TEST_F(RosBagReplay, PosesCarryTheBagsStampsAndMatchTheTruth) {
   EXPECT_EQ(n.transforms, tracking);
 }
 
+// poses.txt of a replay: most frames tracked, each pose at a frame's stamp with the camera centre
+// near that frame's truth.
+void ExpectCameraCentresNearTheTruth(const std::vector<StampedPose>& poses,
+                                     const test::RenderedDrive& drive) {
+  EXPECT_GE(static_cast<int>(poses.size()), kFrames - kMaxFramesNotTracking);
+  for (const StampedPose& pose : poses) {
+    const int i = static_cast<int>(std::lround((pose.t - test::kSceneStart) / test::kSceneStep));
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, kFrames);
+    const Eigen::Vector3d truth = drive.frames[i].cam_from_world.inverse().translation();
+    EXPECT_LT((pose.world_from_cam.translation() - truth).norm(), kPositionTolM) << "frame " << i;
+  }
+}
+
 // The camera from the bag's camera_info (no --camera): the same poses within the tolerances.
 TEST_F(RosBagReplay, TheCameraFromTheBagsCameraInfo) {
   const BagRun& run = TheRun();
@@ -231,14 +245,7 @@ TEST_F(RosBagReplay, TheCameraFromTheBagsCameraInfo) {
       Linetrack(Args(run.bag, "/robot/odom", out, "--camera-info-topic /camera/camera_info"));
   ASSERT_EQ(result.code, 0) << result.err;
   const std::vector<StampedPose> poses = ReadTum((out / "poses.txt").string());
-  EXPECT_GE(static_cast<int>(poses.size()), kFrames - kMaxFramesNotTracking);
-  for (const StampedPose& pose : poses) {
-    const int i = static_cast<int>(std::lround((pose.t - test::kSceneStart) / test::kSceneStep));
-    ASSERT_GE(i, 0);
-    ASSERT_LT(i, kFrames);
-    const Eigen::Vector3d truth = run.drive.frames[i].cam_from_world.inverse().translation();
-    EXPECT_LT((pose.world_from_cam.translation() - truth).norm(), kPositionTolM) << "frame " << i;
-  }
+  ExpectCameraCentresNearTheTruth(poses, run.drive);
 }
 
 // The camera on a calibrated head (--mount, its floor height in place of --height) at the bag's
@@ -254,14 +261,7 @@ TEST_F(RosBagReplay, TheCameraOnACalibratedMountAtTheJointStates) {
                 " --ground-truth " + run.truth.string());
   ASSERT_EQ(result.code, 0) << result.err;
   const std::vector<StampedPose> poses = ReadTum((out / "poses.txt").string());
-  EXPECT_GE(static_cast<int>(poses.size()), kFrames - kMaxFramesNotTracking);
-  for (const StampedPose& pose : poses) {
-    const int i = static_cast<int>(std::lround((pose.t - test::kSceneStart) / test::kSceneStep));
-    ASSERT_GE(i, 0);
-    ASSERT_LT(i, kFrames);
-    const Eigen::Vector3d truth = run.drive.frames[i].cam_from_world.inverse().translation();
-    EXPECT_LT((pose.world_from_cam.translation() - truth).norm(), kPositionTolM) << "frame " << i;
-  }
+  ExpectCameraCentresNearTheTruth(poses, run.drive);
   const OutBagCounts n = CheckOutBag(out.string() + ".bag", run.drive);
   EXPECT_EQ(n.tracking, static_cast<int>(poses.size()));
   EXPECT_GT(n.tracking, 0);

@@ -11,8 +11,8 @@ namespace linetrack {
 
 namespace {
 
-constexpr double kStepPx = 0.5;     // between samples of a profile
-constexpr double kShiftM = 0.01;    // the edge's test shift across itself (metres)
+constexpr double kStepPx = 0.5;            // between samples of a profile
+constexpr double kShiftM = 0.01;           // the edge's test shift across itself (metres)
 constexpr double kCasingNearClipM = 0.05;  // metres
 
 // The image line through the projections of a and b: a point and the unit normal (-d_y, d_x).
