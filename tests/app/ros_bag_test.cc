@@ -16,6 +16,8 @@
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <unistd.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -49,8 +51,9 @@ constexpr double kRegion999Chi2Dof3 = 16.266;
 // robot's alert limit is set above them, so that most poses are tracking.
 constexpr const char* kAlertLimit = "0.3,2";
 
-// A run written once for the suite: its frames rendered with the camera placed by
+// A run written once per test process: its frames rendered with the camera placed by
 // `place_camera` (RenderHallDrive's; null: the nominal mount at kSceneHeight on the pan axis).
+// ctest runs each test in its own process, in parallel: the files are the process's own.
 struct BagRun {
   test::RenderedDrive drive;
   fs::path bag, truth;
@@ -58,8 +61,8 @@ struct BagRun {
   BagRun(const std::string& name,
          const std::function<Eigen::Isometry3d(const SequenceFrame&)>& place_camera)
       : drive(test::RenderHallDrive(kFrames, DegToRad(kPanAmplitudeDeg), place_camera)),
-        bag(fs::path(LINETRACK_BINARY_DIR) / "test_output" / (name + ".bag")),
-        truth(fs::path(LINETRACK_BINARY_DIR) / "test_output" / (name + "_truth.txt")) {
+        bag(OwnPath(name + ".bag")),
+        truth(OwnPath(name + "_truth.txt")) {
     fs::create_directories(bag.parent_path());
     rosbag::Bag out(bag.string(), rosbag::bagmode::Write);
     const Eigen::Isometry3d odom_from_map = PlanarIsometry(drive.frames[0].base.Planar()).inverse();
@@ -87,6 +90,16 @@ struct BagRun {
     }
     std::ofstream(truth) << FormatTum(truth_poses);
   }
+  ~BagRun() {
+    std::error_code ignored;
+    fs::remove(bag, ignored);
+    fs::remove(truth, ignored);
+  }
+
+  // test_output/<pid>_`file`.
+  static fs::path OwnPath(const std::string& file) {
+    return fs::path(LINETRACK_BINARY_DIR) / "test_output" / (std::to_string(getpid()) + "_" + file);
+  }
 };
 
 const BagRun& TheRun() {
@@ -110,7 +123,8 @@ class RosBagReplay : public test_support::CliTest {
   std::string Args(const fs::path& bag, const std::string& odom_topic, const fs::path& out,
                    const std::string& camera = "--camera " + kCameraFile,
                    const std::string& mount = "") {
-    const Pose3Dof start = TheRun().drive.frames[0].base.Planar();
+    // Both runs drive the same base poses.
+    const Pose3Dof start = (mount.empty() ? TheRun() : TheMountRun()).drive.frames[0].base.Planar();
     const std::string head =
         mount.empty() ? "--height " + std::to_string(test::kSceneHeight) : mount;
     return "replay --input " + bag.string() + " --image-topic /camera/image_raw --odom-topic " +
