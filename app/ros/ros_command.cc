@@ -114,8 +114,8 @@ void AddRos(CLI::App& cli, CommandAction* action) {
        "Model error allowance, metres at each edge end (~model_sigma)");
   flag("--kidnap-after-s", "kidnap_after_s", &o.global.kidnap_after_s,
        "Global mode (the robot may have been carried away) after this many seconds of frames "
-       "the matcher around the odometry's prior cannot explain (~kidnap_after_s, default 0.3; "
-       "0: off)");
+       "(at least 2) that the matcher cannot place around the odometry's prior and the global "
+       "mode places elsewhere (~kidnap_after_s, default 0.3; 0: off)");
   flag("--global-after-s", "global_after_s", &o.global.global_after_s,
        "Global mode after this many seconds lost (~global_after_s, default 2.5; 0: off)");
   flag("--global-after-m", "global_after_m", &o.global.global_after_m,

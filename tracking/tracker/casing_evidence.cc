@@ -127,11 +127,12 @@ CasingEvidence FindCasing(const vpImage<unsigned char>& image, const CameraIntri
       !Project(camera, cam_from_world, edge.a + shift, edge.b + shift, &shifted)) {
     return out;
   }
+  // The shifted line's normal against the line's: the same for every point.
+  const double facing = shifted.normal.dot(line.normal);
+  if (!(std::abs(facing) > 0.5)) return out;
   std::vector<double> widths, tolerances, profile;
   for (const Eigen::Vector2d& p : edge.points) {
     // Pixels along the normal per metre of shift: where p + s normal meets the shifted line.
-    const double facing = shifted.normal.dot(line.normal);
-    if (!(std::abs(facing) > 0.5)) continue;
     const double per_m = -shifted.normal.dot(p - shifted.origin) / facing / kShiftM;
     const double nearest =
         std::max(options.min_separation_px, std::abs(per_m) * options.min_width_m);
